@@ -1,0 +1,118 @@
+//! Compiles every shader under `shaders-glsl/` to SPIR-V with glslang (the `glslang`
+//! crate builds the reference compiler from source, no system tool), and writes
+//! `$OUT_DIR/shaders.rs`: a table of (name, SPIR-V words) embedded in the binary.
+
+use glslang::include::{IncludeHandler, IncludeResult, IncludeType};
+use glslang::{
+    Compiler, CompilerOptions, ShaderInput, ShaderSource, ShaderStage, SourceLanguage,
+    SpirvVersion, Target, VulkanVersion,
+};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Resolves `#include "x.glsl"` against `shaders-glsl/common/` (and the includer's
+/// directory), recording every file it reads so cargo reruns when one changes.
+struct Includes {
+    root: PathBuf,
+    seen: BTreeSet<PathBuf>,
+}
+
+impl IncludeHandler for Includes {
+    fn include(
+        &mut self,
+        _ty: IncludeType,
+        header: &str,
+        includer: &str,
+        _depth: usize,
+    ) -> Option<IncludeResult> {
+        let includer_dir = Path::new(includer).parent().map(Path::to_path_buf);
+        let candidates = includer_dir
+            .into_iter()
+            .chain([self.root.join("common"), self.root.clone()])
+            .map(|dir| dir.join(header));
+        for path in candidates {
+            if let Ok(data) = std::fs::read_to_string(&path) {
+                self.seen.insert(path.clone());
+                return Some(IncludeResult {
+                    name: path.to_string_lossy().into_owned(),
+                    data,
+                });
+            }
+        }
+        None
+    }
+}
+
+fn stage_of(path: &Path) -> Option<ShaderStage> {
+    match path.extension()?.to_str()? {
+        "vert" => Some(ShaderStage::Vertex),
+        "frag" => Some(ShaderStage::Fragment),
+        "comp" => Some(ShaderStage::Compute),
+        _ => None,
+    }
+}
+
+fn main() {
+    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap()).join("shaders-glsl");
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    println!("cargo:rerun-if-changed={}", root.display());
+    println!("cargo:rerun-if-changed={}", root.join("common").display());
+
+    let mut sources: Vec<PathBuf> = std::fs::read_dir(&root)
+        .expect("shaders-glsl/ is missing")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| stage_of(p).is_some())
+        .collect();
+    sources.sort();
+
+    let compiler = Compiler::acquire().expect("glslang failed to initialise");
+    let options = CompilerOptions {
+        source_language: SourceLanguage::GLSL,
+        target: Target::Vulkan {
+            version: VulkanVersion::Vulkan1_2,
+            spirv_version: SpirvVersion::SPIRV1_5,
+        },
+        ..Default::default()
+    };
+
+    let mut table = String::from("pub static SHADERS: &[(&str, &[u32])] = &[\n");
+    let mut failures = Vec::new();
+    for path in &sources {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let text = std::fs::read_to_string(path).expect("unreadable shader source");
+        let source = ShaderSource::from(text);
+        let mut includes = Includes {
+            root: root.clone(),
+            seen: BTreeSet::new(),
+        };
+        let stage = stage_of(path).unwrap();
+        let spirv = ShaderInput::new(&source, stage, &options, None, Some(&mut includes))
+            .map_err(|e| e.to_string())
+            .and_then(|input| compiler.create_shader(input).map_err(|e| e.to_string()))
+            .and_then(|shader| shader.compile().map_err(|e| e.to_string()));
+        for inc in &includes.seen {
+            println!("cargo:rerun-if-changed={}", inc.display());
+        }
+        match spirv {
+            Ok(words) => {
+                let file = out.join(format!("{name}.spv"));
+                let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+                std::fs::write(&file, bytes).expect("cannot write SPIR-V");
+                // Stored as u32 words: 4-byte aligned, as ash::util::read_spv wants.
+                writeln!(table, "    ({name:?}, &{words:?}),").unwrap();
+            }
+            // glslang's log already carries "ERROR: <file>:<line>: <message>".
+            Err(e) => failures.push(format!("{}:\n{e}", path.display())),
+        }
+    }
+    table.push_str("];\n");
+    if !failures.is_empty() {
+        for f in &failures {
+            println!("cargo:warning={}", f.lines().next().unwrap_or_default());
+        }
+        panic!("GLSL compilation failed:\n\n{}", failures.join("\n\n"));
+    }
+    std::fs::write(out.join("shaders.rs"), table).expect("cannot write shaders.rs");
+}

@@ -1,0 +1,461 @@
+//! Instance, device, queue, memory allocator and validation: the root every GPU
+//! object holds an `Arc` of, so that it is destroyed last.
+
+use super::validation::{messenger_info, ValidationLog};
+use crate::error::{Error, Result, VkResultExt};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use serde::Serialize;
+use std::ffi::{c_char, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Enable VK_LAYER_KHRONOS_validation with synchronization validation.
+    pub validation: bool,
+    /// Pick the first device whose name contains this (case-insensitive).
+    pub device: Option<String>,
+}
+
+impl ContextOptions {
+    /// Options from the environment: `DERMIS_VALIDATION=1`, `DERMIS_DEVICE=<substring>`.
+    pub fn from_env() -> Self {
+        Self {
+            validation: std::env::var("DERMIS_VALIDATION").is_ok_and(|v| v == "1"),
+            device: std::env::var("DERMIS_DEVICE")
+                .ok()
+                .filter(|s| !s.is_empty()),
+        }
+    }
+}
+
+/// What `dermis info` reports, and what frame reports are stamped with.
+#[derive(Clone, Debug, Serialize)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub device_type: String,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub api_version: String,
+    pub vendor_id: u32,
+    pub device_id: u32,
+    pub timestamps: bool,
+    pub timestamp_period_ns: f32,
+    pub timestamp_valid_bits: u32,
+    pub max_image_dimension_2d: u32,
+    pub memory_heaps: Vec<MemoryHeap>,
+    pub validation: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct MemoryHeap {
+    pub size_bytes: u64,
+    pub device_local: bool,
+}
+
+pub struct Context {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
+    queue: Mutex<vk::Queue>,
+    pub queue_family: u32,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub info: DeviceInfo,
+    validation: Option<Arc<ValidationLog>>,
+}
+
+fn cstr(chars: &[c_char]) -> String {
+    // Vulkan strings are NUL-terminated within fixed arrays.
+    let bytes: Vec<u8> = chars
+        .iter()
+        .take_while(|&&c| c != 0)
+        .map(|&c| c as u8)
+        .collect();
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+fn version_string(v: u32) -> String {
+    format!(
+        "{}.{}.{}",
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v)
+    )
+}
+
+/// Preference order when no device is named: discrete > integrated > virtual > CPU.
+fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
+    match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 3,
+        _ => 4,
+    }
+}
+
+fn type_name(t: vk::PhysicalDeviceType) -> &'static str {
+    match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
+        vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
+        vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
+        vk::PhysicalDeviceType::CPU => "CPU",
+        _ => "other",
+    }
+}
+
+impl Context {
+    pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
+        // SAFETY: loading libvulkan runs its initialisers; nothing else is in flight.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::NoLoader(e.to_string()))?;
+        let validation = options
+            .validation
+            .then(|| Arc::new(ValidationLog::default()));
+        let (instance, messenger) = create_instance(&entry, validation.as_deref())?;
+        // From here on, `partial` destroys what exists if a later step fails.
+        let partial = Partial {
+            instance: &instance,
+            messenger: messenger.as_ref(),
+        };
+        let (physical, queue_family, info) =
+            choose_device(&instance, options.device.as_deref(), validation.is_some())?;
+        let device = create_device(&instance, physical, queue_family)?;
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|source| {
+            unsafe { device.destroy_device(None) };
+            Error::Alloc {
+                name: "allocator".into(),
+                source,
+            }
+        })?;
+        std::mem::forget(partial);
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let debug_utils = messenger
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device))
+            .or_else(|| {
+                has_instance_extension(&entry, ash::ext::debug_utils::NAME)
+                    .then(|| ash::ext::debug_utils::Device::new(&instance, &device))
+            });
+        let push_descriptor = ash::khr::push_descriptor::Device::new(&instance, &device);
+        log::info!(
+            "device: {} ({}), driver {} {}, Vulkan {}",
+            info.name,
+            info.device_type,
+            info.driver_name,
+            info.driver_info,
+            info.api_version
+        );
+        Ok(Arc::new(Self {
+            _entry: entry,
+            instance,
+            messenger,
+            debug_utils,
+            physical,
+            device,
+            push_descriptor,
+            queue: Mutex::new(queue),
+            queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            info,
+            validation,
+        }))
+    }
+
+    /// The validation log, when validation is on. Keep the `Arc` to read it after
+    /// the context is dropped (leaks are reported at device destruction).
+    pub fn validation(&self) -> Option<Arc<ValidationLog>> {
+        self.validation.clone()
+    }
+
+    pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
+        self.queue.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Names a Vulkan object for debuggers and validation messages.
+    pub(crate) fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(du) = &self.debug_utils else { return };
+        let Ok(name) = std::ffi::CString::new(name) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
+        // Naming is best effort: a failure only loses a label.
+        let _ = unsafe { du.set_debug_utils_object_name(&info) };
+    }
+
+    pub fn wait_idle(&self) -> Result<()> {
+        let _queue = self.queue();
+        unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            // Device memory goes back before the device itself.
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+            if let Some((du, messenger)) = &self.messenger {
+                du.destroy_debug_utils_messenger(*messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// Destroys the instance (and messenger) if device creation fails half way.
+struct Partial<'a> {
+    instance: &'a ash::Instance,
+    messenger: Option<&'a (ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+}
+
+impl Drop for Partial<'_> {
+    fn drop(&mut self) {
+        unsafe {
+            if let Some((du, m)) = self.messenger {
+                du.destroy_debug_utils_messenger(*m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+fn has_instance_extension(entry: &ash::Entry, name: &CStr) -> bool {
+    unsafe { entry.enumerate_instance_extension_properties(None) }
+        .unwrap_or_default()
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(name))
+}
+
+type Messenger = (ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT);
+
+fn create_instance(
+    entry: &ash::Entry,
+    validation: Option<&ValidationLog>,
+) -> Result<(ash::Instance, Option<Messenger>)> {
+    let app = vk::ApplicationInfo::default()
+        .application_name(c"dermis")
+        .engine_name(c"dermis")
+        .api_version(vk::API_VERSION_1_3);
+    let mut layers: Vec<*const c_char> = Vec::new();
+    let mut extensions: Vec<*const c_char> = Vec::new();
+    if has_instance_extension(entry, ash::ext::debug_utils::NAME) || validation.is_some() {
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    if validation.is_some() {
+        let available = unsafe { entry.enumerate_instance_layer_properties() }
+            .vk("vkEnumerateInstanceLayerProperties")?;
+        if !available
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+        {
+            return Err(Error::NoValidationLayer);
+        }
+        layers.push(VALIDATION_LAYER.as_ptr());
+    }
+    // Synchronization validation is switched on through VkValidationFeaturesEXT
+    // (the Debian 12 layer, 1.3.239, predates VK_EXT_layer_settings).
+    let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+    let mut messenger_ci = validation.map(messenger_info);
+    let mut info = vk::InstanceCreateInfo::default()
+        .application_info(&app)
+        .enabled_layer_names(&layers)
+        .enabled_extension_names(&extensions);
+    if let Some(ci) = messenger_ci.as_mut() {
+        // Chained so that instance creation and destruction are validated too.
+        info = info.push_next(ci).push_next(&mut features);
+    }
+    let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
+        vk::Result::ERROR_INCOMPATIBLE_DRIVER | vk::Result::ERROR_INITIALIZATION_FAILED => {
+            Error::NoDevice
+        }
+        result => Error::Vk {
+            call: "vkCreateInstance",
+            result,
+        },
+    })?;
+    let messenger = match validation {
+        Some(log) => {
+            let du = ash::ext::debug_utils::Instance::new(entry, &instance);
+            match unsafe { du.create_debug_utils_messenger(&messenger_info(log), None) } {
+                Ok(m) => Some((du, m)),
+                Err(result) => {
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(Error::Vk {
+                        call: "vkCreateDebugUtilsMessengerEXT",
+                        result,
+                    });
+                }
+            }
+        }
+        None => None,
+    };
+    Ok((instance, messenger))
+}
+
+fn choose_device(
+    instance: &ash::Instance,
+    wanted: Option<&str>,
+    validation: bool,
+) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
+    let devices =
+        unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    if devices.is_empty() {
+        return Err(Error::NoDevice);
+    }
+    let mut candidates = Vec::new();
+    for &pd in &devices {
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        let name = cstr(&props.device_name);
+        if let Some(w) = wanted {
+            if !name.to_lowercase().contains(&w.to_lowercase()) {
+                continue;
+            }
+        }
+        candidates.push((type_rank(props.device_type), pd, name));
+    }
+    if candidates.is_empty() {
+        let available = devices
+            .iter()
+            .map(|&pd| cstr(&unsafe { instance.get_physical_device_properties(pd) }.device_name))
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(Error::DeviceNotFound {
+            wanted: wanted.unwrap_or_default().to_string(),
+            available,
+        });
+    }
+    candidates.sort_by_key(|c| c.0);
+    let mut reasons = Vec::new();
+    for (_, pd, name) in candidates {
+        match check_device(instance, pd) {
+            Ok(family) => return Ok((pd, family, device_info(instance, pd, family, validation))),
+            Err(why) => reasons.push(format!("{name}: {why}")),
+        }
+    }
+    Err(Error::Unsupported {
+        device: "every device".into(),
+        what: reasons.join("; "),
+    })
+}
+
+/// Returns the queue family to use, or why the device does not qualify.
+fn check_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<u32, String> {
+    let props = unsafe { instance.get_physical_device_properties(pd) };
+    if props.api_version < vk::API_VERSION_1_3 {
+        return Err(format!(
+            "Vulkan {} < 1.3",
+            version_string(props.api_version)
+        ));
+    }
+    let exts =
+        unsafe { instance.enumerate_device_extension_properties(pd) }.map_err(|e| e.to_string())?;
+    if !exts
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::push_descriptor::NAME))
+    {
+        return Err("no VK_KHR_push_descriptor".into());
+    }
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut f12)
+        .push_next(&mut f13);
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    if f13.synchronization2 == 0 || f13.dynamic_rendering == 0 || f12.host_query_reset == 0 {
+        return Err("needs synchronization2, dynamicRendering and hostQueryReset".into());
+    }
+    let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    let wanted = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
+    families
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.queue_flags.contains(wanted))
+        .max_by_key(|(_, f)| f.timestamp_valid_bits)
+        .map(|(i, _)| i as u32)
+        .ok_or_else(|| "no graphics+compute queue".into())
+}
+
+fn device_info(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    family: u32,
+    validation: bool,
+) -> DeviceInfo {
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    unsafe { instance.get_physical_device_properties2(pd, &mut p2) };
+    let props = p2.properties;
+    let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+    let valid_bits = families
+        .get(family as usize)
+        .map_or(0, |f| f.timestamp_valid_bits);
+    let mem = unsafe { instance.get_physical_device_memory_properties(pd) };
+    let heaps = mem.memory_heaps[..mem.memory_heap_count as usize]
+        .iter()
+        .map(|h| MemoryHeap {
+            size_bytes: h.size,
+            device_local: h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL),
+        })
+        .collect();
+    DeviceInfo {
+        name: cstr(&props.device_name),
+        device_type: type_name(props.device_type).into(),
+        driver_name: cstr(&driver.driver_name),
+        driver_info: cstr(&driver.driver_info),
+        api_version: version_string(props.api_version),
+        vendor_id: props.vendor_id,
+        device_id: props.device_id,
+        timestamps: valid_bits > 0 && props.limits.timestamp_compute_and_graphics != 0,
+        timestamp_period_ns: props.limits.timestamp_period,
+        timestamp_valid_bits: valid_bits,
+        max_image_dimension_2d: props.limits.max_image_dimension2_d,
+        memory_heaps: heaps,
+        validation,
+    }
+}
+
+fn create_device(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    family: u32,
+) -> Result<ash::Device> {
+    let priorities = [1.0];
+    let queues = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(family)
+        .queue_priorities(&priorities)];
+    let extensions = [ash::khr::push_descriptor::NAME.as_ptr()];
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
+        .synchronization2(true)
+        .dynamic_rendering(true);
+    let info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queues)
+        .enabled_extension_names(&extensions)
+        .push_next(&mut f12)
+        .push_next(&mut f13);
+    unsafe { instance.create_device(pd, &info, None) }.vk("vkCreateDevice")
+}

@@ -1,0 +1,16 @@
+//! A thin, RAII layer over ash: context (instance, device, validation), memory
+//! (gpu-allocator), images, buffers, samplers, pipelines, embedded SPIR-V.
+
+mod context;
+mod pipeline;
+mod resources;
+pub mod shaders;
+mod validation;
+
+pub use context::{Context, ContextOptions, DeviceInfo, MemoryHeap};
+pub use pipeline::{Binding, GraphicsDesc, Pipeline};
+pub(crate) use resources::color_range;
+pub use resources::{texel_bytes, Buffer, Image, ImageDesc, Sampler};
+pub use validation::ValidationLog;
+
+pub use gpu_allocator::MemoryLocation;

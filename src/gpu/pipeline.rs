@@ -1,0 +1,270 @@
+//! Compute and graphics pipelines built from embedded SPIR-V. Descriptors are
+//! push descriptors (VK_KHR_push_descriptor): one set per pipeline, written at
+//! record time, so there are no descriptor pools to manage.
+
+use super::{shaders, Context};
+use crate::error::{Result, VkResultExt};
+use ash::vk;
+use std::sync::Arc;
+
+/// One binding of a pipeline's descriptor set, in binding order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Binding {
+    StorageImage,
+    SampledImage,
+    UniformBuffer,
+    StorageBuffer,
+}
+
+impl Binding {
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            Binding::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            Binding::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            Binding::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+        }
+    }
+}
+
+/// Fixed-function state of a graphics pipeline (dynamic rendering, dynamic viewport).
+pub struct GraphicsDesc<'a> {
+    pub vertex: &'a str,
+    pub fragment: &'a str,
+    pub bindings: &'a [Binding],
+    pub push_constant_bytes: u32,
+    pub color_formats: &'a [vk::Format],
+    pub depth_format: Option<vk::Format>,
+    /// Vertex buffer stride and (format, offset) per location; `None`: no vertex input.
+    pub vertex_layout: Option<(u32, &'a [(vk::Format, u32)])>,
+    pub cull_mode: vk::CullModeFlags,
+}
+
+pub struct Pipeline {
+    ctx: Arc<Context>,
+    pub name: String,
+    pub raw: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    pub bind_point: vk::PipelineBindPoint,
+    pub stages: vk::ShaderStageFlags,
+}
+
+impl Pipeline {
+    fn with_layout(
+        ctx: &Arc<Context>,
+        name: &str,
+        bind_point: vk::PipelineBindPoint,
+        stages: vk::ShaderStageFlags,
+        bindings: &[Binding],
+        push_constant_bytes: u32,
+    ) -> Result<Self> {
+        let device = &ctx.device;
+        let vk_bindings: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(b.descriptor_type())
+                    .descriptor_count(1)
+                    .stage_flags(stages)
+            })
+            .collect();
+        let set_info = vk::DescriptorSetLayoutCreateInfo::default()
+            .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
+            .bindings(&vk_bindings);
+        let set_layout = unsafe { device.create_descriptor_set_layout(&set_info, None) }
+            .vk("vkCreateDescriptorSetLayout")?;
+        let mut p = Pipeline {
+            ctx: ctx.clone(),
+            name: name.into(),
+            raw: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layout,
+            bind_point,
+            stages,
+        };
+        let ranges = [vk::PushConstantRange {
+            stage_flags: stages,
+            offset: 0,
+            size: push_constant_bytes,
+        }];
+        let set_layouts = [set_layout];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        if push_constant_bytes > 0 {
+            layout_info = layout_info.push_constant_ranges(&ranges);
+        }
+        p.layout = unsafe { device.create_pipeline_layout(&layout_info, None) }
+            .vk("vkCreatePipelineLayout")?;
+        Ok(p)
+    }
+
+    pub fn compute(
+        ctx: &Arc<Context>,
+        shader: &str,
+        bindings: &[Binding],
+        push_constant_bytes: u32,
+    ) -> Result<Arc<Self>> {
+        let mut p = Self::with_layout(
+            ctx,
+            shader,
+            vk::PipelineBindPoint::COMPUTE,
+            vk::ShaderStageFlags::COMPUTE,
+            bindings,
+            push_constant_bytes,
+        )?;
+        let module = ShaderModule::new(ctx, shader)?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module.raw)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(p.layout);
+        p.raw = unsafe {
+            ctx.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+        }
+        .map_err(|(_, e)| e)
+        .vk("vkCreateComputePipelines")?[0];
+        ctx.name(p.raw, shader);
+        Ok(Arc::new(p))
+    }
+
+    pub fn graphics(ctx: &Arc<Context>, desc: &GraphicsDesc) -> Result<Arc<Self>> {
+        let name = format!("{}+{}", desc.vertex, desc.fragment);
+        let mut p = Self::with_layout(
+            ctx,
+            &name,
+            vk::PipelineBindPoint::GRAPHICS,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            desc.bindings,
+            desc.push_constant_bytes,
+        )?;
+        let vs = ShaderModule::new(ctx, desc.vertex)?;
+        let fs = ShaderModule::new(ctx, desc.fragment)?;
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vs.raw)
+                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fs.raw)
+                .name(c"main"),
+        ];
+        let mut vertex_bindings = Vec::new();
+        let mut vertex_attributes = Vec::new();
+        if let Some((stride, attrs)) = desc.vertex_layout {
+            vertex_bindings.push(vk::VertexInputBindingDescription {
+                binding: 0,
+                stride,
+                input_rate: vk::VertexInputRate::VERTEX,
+            });
+            for (location, &(format, offset)) in attrs.iter().enumerate() {
+                vertex_attributes.push(vk::VertexInputAttributeDescription {
+                    location: location as u32,
+                    binding: 0,
+                    format,
+                    offset,
+                });
+            }
+        }
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vertex_bindings)
+            .vertex_attribute_descriptions(&vertex_attributes);
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(desc.cull_mode)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_format.is_some())
+            .depth_write_enable(desc.depth_format.is_some())
+            .depth_compare_op(vk::CompareOp::LESS);
+        let blend_attachments: Vec<_> = desc
+            .color_formats
+            .iter()
+            .map(|_| {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            })
+            .collect();
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(desc.color_formats)
+            .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(p.layout)
+            .push_next(&mut rendering);
+        p.raw = unsafe {
+            ctx.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+        }
+        .map_err(|(_, e)| e)
+        .vk("vkCreateGraphicsPipelines")?[0];
+        ctx.name(p.raw, &name);
+        Ok(Arc::new(p))
+    }
+
+    pub(crate) fn set_layout(&self) -> vk::DescriptorSetLayout {
+        self.set_layout
+    }
+}
+
+impl Drop for Pipeline {
+    fn drop(&mut self) {
+        let d = &self.ctx.device;
+        unsafe {
+            if self.raw != vk::Pipeline::null() {
+                d.destroy_pipeline(self.raw, None);
+            }
+            if self.layout != vk::PipelineLayout::null() {
+                d.destroy_pipeline_layout(self.layout, None);
+            }
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A shader module, alive only while its pipeline is created.
+struct ShaderModule<'a> {
+    ctx: &'a Context,
+    raw: vk::ShaderModule,
+}
+
+impl<'a> ShaderModule<'a> {
+    fn new(ctx: &'a Context, name: &str) -> Result<Self> {
+        let words = shaders::spirv(name)?;
+        let info = vk::ShaderModuleCreateInfo::default().code(words);
+        let raw =
+            unsafe { ctx.device.create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
+        Ok(Self { ctx, raw })
+    }
+}
+
+impl Drop for ShaderModule<'_> {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_shader_module(self.raw, None) };
+    }
+}

@@ -1,0 +1,831 @@
+//! Recording and submitting compiled graphs: frames in flight, the transient
+//! image pool, per-pass debug labels and GPU timestamps.
+
+use super::plan::{Barrier, Plan, PoolState};
+use super::{BufferRef, Graph, ImageRef, Imported, LoadOp, ResourceKind};
+use crate::error::{Error, Result, VkResultExt};
+use crate::gpu::{color_range, Context, Image, ImageDesc, Pipeline, Sampler};
+use crate::profile::{FrameReport, PassTime};
+use ash::vk;
+use std::ffi::CString;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A graph with its plan, ready to submit. The plan may be inspected (and, in
+/// tests, deliberately broken) before submission.
+pub struct Compiled {
+    pub plan: Plan,
+    graph: Graph,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct ResolvedImage {
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    pub desc: ImageDesc,
+}
+
+/// A descriptor for [`PassCx::push_descriptors`]; layouts follow the graph's
+/// access vocabulary (storage: GENERAL, sampled: SHADER_READ_ONLY_OPTIMAL).
+pub enum Descriptor<'a> {
+    StorageImage(ImageRef),
+    Sampled(ImageRef, &'a Sampler),
+    /// An image outside the graph, already in SHADER_READ_ONLY_OPTIMAL.
+    StaticSampled(&'a Image, &'a Sampler),
+    Uniform(BufferRef),
+    Storage(BufferRef),
+}
+
+/// What a pass's closure records with.
+pub struct PassCx<'a> {
+    pub ctx: &'a Arc<Context>,
+    pub cmd: vk::CommandBuffer,
+    images: &'a [Option<ResolvedImage>],
+    buffers: &'a [Option<vk::Buffer>],
+}
+
+impl PassCx<'_> {
+    pub fn image(&self, r: ImageRef) -> ResolvedImage {
+        self.images[r.0].expect("ImageRef names an image of this graph")
+    }
+
+    pub fn buffer(&self, r: BufferRef) -> vk::Buffer {
+        self.buffers[r.0].expect("BufferRef names a buffer of this graph")
+    }
+
+    fn device(&self) -> &ash::Device {
+        &self.ctx.device
+    }
+
+    pub fn bind(&self, p: &Pipeline) {
+        unsafe {
+            self.device()
+                .cmd_bind_pipeline(self.cmd, p.bind_point, p.raw)
+        };
+    }
+
+    pub fn push_descriptors(&self, p: &Pipeline, descriptors: &[Descriptor]) {
+        let mut image_infos = Vec::with_capacity(descriptors.len());
+        let mut buffer_infos = Vec::with_capacity(descriptors.len());
+        for d in descriptors {
+            match *d {
+                Descriptor::StorageImage(r) => image_infos.push(vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: self.image(r).view,
+                    image_layout: vk::ImageLayout::GENERAL,
+                }),
+                Descriptor::Sampled(r, s) => image_infos.push(vk::DescriptorImageInfo {
+                    sampler: s.raw,
+                    image_view: self.image(r).view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }),
+                Descriptor::StaticSampled(i, s) => image_infos.push(vk::DescriptorImageInfo {
+                    sampler: s.raw,
+                    image_view: i.view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }),
+                Descriptor::Uniform(b) | Descriptor::Storage(b) => {
+                    buffer_infos.push(vk::DescriptorBufferInfo {
+                        buffer: self.buffer(b),
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    })
+                }
+            }
+        }
+        let (mut ii, mut bi) = (0, 0);
+        let writes: Vec<_> = descriptors
+            .iter()
+            .enumerate()
+            .map(|(binding, d)| {
+                let w = vk::WriteDescriptorSet::default().dst_binding(binding as u32);
+                match d {
+                    Descriptor::Uniform(_) | Descriptor::Storage(_) => {
+                        let ty = if matches!(d, Descriptor::Uniform(_)) {
+                            vk::DescriptorType::UNIFORM_BUFFER
+                        } else {
+                            vk::DescriptorType::STORAGE_BUFFER
+                        };
+                        bi += 1;
+                        w.descriptor_type(ty)
+                            .buffer_info(std::slice::from_ref(&buffer_infos[bi - 1]))
+                    }
+                    _ => {
+                        let ty = if matches!(d, Descriptor::StorageImage(_)) {
+                            vk::DescriptorType::STORAGE_IMAGE
+                        } else {
+                            vk::DescriptorType::COMBINED_IMAGE_SAMPLER
+                        };
+                        ii += 1;
+                        w.descriptor_type(ty)
+                            .image_info(std::slice::from_ref(&image_infos[ii - 1]))
+                    }
+                }
+            })
+            .collect();
+        debug_assert!(p.set_layout() != vk::DescriptorSetLayout::null());
+        unsafe {
+            self.ctx.push_descriptor.cmd_push_descriptor_set(
+                self.cmd,
+                p.bind_point,
+                p.layout,
+                0,
+                &writes,
+            )
+        };
+    }
+
+    pub fn push_constants<T: bytemuck::NoUninit>(&self, p: &Pipeline, data: &T) {
+        unsafe {
+            self.device().cmd_push_constants(
+                self.cmd,
+                p.layout,
+                p.stages,
+                0,
+                bytemuck::bytes_of(data),
+            )
+        };
+    }
+
+    /// Dispatches enough `local`-sized groups to cover `width` × `height`.
+    pub fn dispatch_2d(&self, width: u32, height: u32, local: (u32, u32)) {
+        unsafe {
+            self.device().cmd_dispatch(
+                self.cmd,
+                width.div_ceil(local.0),
+                height.div_ceil(local.1),
+                1,
+            )
+        };
+    }
+
+    pub fn draw(&self, vertices: u32, instances: u32) {
+        unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
+    }
+
+    pub fn copy_image_to_buffer(&self, image: ImageRef, buffer: BufferRef) {
+        let img = self.image(image);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D {
+                width: img.desc.width,
+                height: img.desc.height,
+                depth: 1,
+            });
+        unsafe {
+            self.device().cmd_copy_image_to_buffer(
+                self.cmd,
+                img.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.buffer(buffer),
+                &[region],
+            )
+        };
+    }
+
+    pub fn copy_buffer_to_image(&self, buffer: BufferRef, image: ImageRef) {
+        let img = self.image(image);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D {
+                width: img.desc.width,
+                height: img.desc.height,
+                depth: 1,
+            });
+        unsafe {
+            self.device().cmd_copy_buffer_to_image(
+                self.cmd,
+                self.buffer(buffer),
+                img.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+    }
+
+    pub fn clear_image(&self, image: ImageRef, rgba: [f32; 4]) {
+        let img = self.image(image);
+        let value = vk::ClearColorValue { float32: rgba };
+        unsafe {
+            self.device().cmd_clear_color_image(
+                self.cmd,
+                img.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &value,
+                &[color_range(img.desc.mip_levels)],
+            )
+        };
+    }
+}
+
+/// Per frame in flight: command buffer, fence, timestamp queries.
+struct FrameSlot {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    queries: vk::QueryPool,
+    query_capacity: u32,
+    in_flight: Option<InFlight>,
+}
+
+/// What a submitted frame keeps alive until its fence signals.
+struct InFlight {
+    frame: u64,
+    pass_names: Vec<String>,
+    cpu_record_ns: f64,
+    cpu_submit_ns: f64,
+    _graph: Graph,
+}
+
+/// Which clock measures passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Clock {
+    /// GPU timestamps around each pass, one submission per frame (real GPUs).
+    GpuTimestamp,
+    /// One submission per pass, timed on the host from submit to fence. On CPU
+    /// devices this is the true cost: lavapipe (Mesa 22.3) resolves timestamp
+    /// queries on its rasterizer threads while compute runs on the queue thread,
+    /// so its timestamps do not bracket compute passes.
+    HostFence,
+}
+
+impl Clock {
+    /// Timestamps where they measure work, host fences on CPU devices.
+    pub fn auto(info: &crate::gpu::DeviceInfo) -> Self {
+        if info.timestamps && info.device_type != "CPU" {
+            Clock::GpuTimestamp
+        } else {
+            Clock::HostFence
+        }
+    }
+}
+
+pub struct Executor {
+    ctx: Arc<Context>,
+    clock: Clock,
+    slots: Vec<FrameSlot>,
+    next: usize,
+    frame: u64,
+    pool: PoolState,
+    pool_images: Vec<Option<Image>>,
+}
+
+impl Executor {
+    /// `frames_in_flight` ≥ 1 (2 is the usual choice).
+    pub fn new(ctx: &Arc<Context>, frames_in_flight: usize) -> Result<Self> {
+        let mut ex = Executor {
+            ctx: ctx.clone(),
+            clock: Clock::auto(&ctx.info),
+            slots: Vec::new(),
+            next: 0,
+            frame: 0,
+            pool: PoolState::default(),
+            pool_images: Vec::new(),
+        };
+        for _ in 0..frames_in_flight.max(1) {
+            let slot = ex.new_slot()?;
+            ex.slots.push(slot);
+        }
+        Ok(ex)
+    }
+
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// Overrides the automatic choice; `GpuTimestamp` needs device timestamps.
+    pub fn set_clock(&mut self, clock: Clock) -> Result<()> {
+        if clock == Clock::GpuTimestamp && !self.ctx.info.timestamps {
+            return Err(Error::Input(format!(
+                "{} has no timestamp queries",
+                self.ctx.info.name
+            )));
+        }
+        self.clock = clock;
+        Ok(())
+    }
+
+    fn new_slot(&self) -> Result<FrameSlot> {
+        let d = &self.ctx.device;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(self.ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        let pool = unsafe { d.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        let mut slot = FrameSlot {
+            pool,
+            cmd: vk::CommandBuffer::null(),
+            fence: vk::Fence::null(),
+            queries: vk::QueryPool::null(),
+            query_capacity: 0,
+            in_flight: None,
+        };
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let made = unsafe { d.allocate_command_buffers(&alloc) }
+            .vk("vkAllocateCommandBuffers")
+            .and_then(|cmds| {
+                slot.cmd = cmds[0];
+                unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.vk("vkCreateFence")
+            });
+        match made {
+            Ok(fence) => {
+                slot.fence = fence;
+                Ok(slot)
+            }
+            Err(e) => {
+                self.destroy_slot(&slot);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy_slot(&self, slot: &FrameSlot) {
+        let d = &self.ctx.device;
+        unsafe {
+            if slot.queries != vk::QueryPool::null() {
+                d.destroy_query_pool(slot.queries, None);
+            }
+            if slot.fence != vk::Fence::null() {
+                d.destroy_fence(slot.fence, None);
+            }
+            d.destroy_command_pool(slot.pool, None);
+        }
+    }
+
+    /// Plans a graph against the executor's transient pool. Submit the result
+    /// next: the pool's state assumes it runs.
+    pub fn compile(&mut self, graph: Graph) -> Result<Compiled> {
+        let plan = graph.compile(&mut self.pool)?;
+        Ok(Compiled { plan, graph })
+    }
+
+    /// Compiles and submits; returns the report of the frame that last used this
+    /// frame slot, if any (it has completed).
+    pub fn run(&mut self, graph: Graph) -> Result<Option<FrameReport>> {
+        let compiled = self.compile(graph)?;
+        self.submit(compiled)
+    }
+
+    pub fn submit(&mut self, compiled: Compiled) -> Result<Option<FrameReport>> {
+        let index = self.next;
+        let previous = self.retire(index)?;
+        self.realize_pool()?;
+        let started = Instant::now();
+        let (images, buffers) = self.resolve(&compiled)?;
+        let names: Vec<String> = compiled
+            .plan
+            .passes
+            .iter()
+            .map(|p| p.name.clone())
+            .collect();
+        let n = names.len();
+        if self.clock == Clock::HostFence {
+            let report = self.run_isolated(index, &compiled, &images, &buffers, names)?;
+            self.frame += 1;
+            return Ok(previous.or(Some(report)));
+        }
+        self.ensure_queries(index, 2 + 2 * n as u32)?;
+        self.record(index, &compiled, &images, &buffers, 0..n)?;
+        let recorded = Instant::now();
+        self.submit_slot(index)?;
+        let submitted = Instant::now();
+        self.slots[index].in_flight = Some(InFlight {
+            frame: self.frame,
+            pass_names: names,
+            cpu_record_ns: (recorded - started).as_nanos() as f64,
+            cpu_submit_ns: (submitted - recorded).as_nanos() as f64,
+            _graph: compiled.graph,
+        });
+        self.frame += 1;
+        self.next = (index + 1) % self.slots.len();
+        Ok(previous)
+    }
+
+    fn submit_slot(&self, index: usize) -> Result<()> {
+        let slot = &self.slots[index];
+        let cmd_info = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmd_info)];
+        let queue = self.ctx.queue();
+        unsafe { self.ctx.device.queue_submit2(*queue, &submit, slot.fence) }.vk("vkQueueSubmit2")
+    }
+
+    /// [`Clock::HostFence`]: each pass is its own submission, waited for and timed.
+    fn run_isolated(
+        &self,
+        index: usize,
+        c: &Compiled,
+        images: &[Option<ResolvedImage>],
+        buffers: &[Option<vk::Buffer>],
+        names: Vec<String>,
+    ) -> Result<FrameReport> {
+        let fence = self.slots[index].fence;
+        let d = &self.ctx.device;
+        let frame_start = Instant::now();
+        let (mut record_ns, mut submit_ns) = (0.0, 0.0);
+        let mut passes = Vec::with_capacity(names.len());
+        for i in 0..names.len().max(1) {
+            let t0 = Instant::now();
+            self.record(index, c, images, buffers, i..(i + 1).min(names.len()))?;
+            let t1 = Instant::now();
+            self.submit_slot(index)?;
+            let t2 = Instant::now();
+            unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+            unsafe { d.reset_fences(&[fence]) }.vk("vkResetFences")?;
+            let t3 = Instant::now();
+            record_ns += (t1 - t0).as_nanos() as f64;
+            submit_ns += (t2 - t1).as_nanos() as f64;
+            if let Some(name) = names.get(i) {
+                passes.push(PassTime {
+                    name: name.clone(),
+                    gpu_ns: Some((t3 - t1).as_nanos() as f64),
+                });
+            }
+        }
+        Ok(FrameReport {
+            frame: self.frame,
+            passes,
+            gpu_frame_ns: Some(frame_start.elapsed().as_nanos() as f64),
+            cpu_record_ns: record_ns,
+            cpu_submit_ns: submit_ns,
+            dropped_deltas: 0,
+            clock: "host-fence".into(),
+        })
+    }
+
+    /// Waits for every frame in flight; returns their reports in submission order.
+    pub fn finish(&mut self) -> Result<Vec<FrameReport>> {
+        let mut reports = Vec::new();
+        for k in 0..self.slots.len() {
+            let index = (self.next + k) % self.slots.len();
+            reports.extend(self.retire(index)?);
+        }
+        Ok(reports)
+    }
+
+    /// Device memory held by pooled transient images, in bytes.
+    pub fn pool_bytes(&self) -> u64 {
+        self.pool_images
+            .iter()
+            .flatten()
+            .map(|i| {
+                let texel = crate::gpu::texel_bytes(i.desc.format).unwrap_or(0) as u64;
+                i.desc.width as u64 * i.desc.height as u64 * texel
+            })
+            .sum()
+    }
+
+    /// Waits for the frame in `index` (if any) and turns its timestamps into a report.
+    fn retire(&mut self, index: usize) -> Result<Option<FrameReport>> {
+        let Some(done) = self.slots[index].in_flight.take() else {
+            return Ok(None);
+        };
+        let slot = &self.slots[index];
+        let d = &self.ctx.device;
+        unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        unsafe { d.reset_fences(&[slot.fence]) }.vk("vkResetFences")?;
+        let mut report = if slot.queries != vk::QueryPool::null() {
+            let mut raw = vec![0u64; 2 + 2 * done.pass_names.len()];
+            unsafe {
+                d.get_query_pool_results(
+                    slot.queries,
+                    0,
+                    &mut raw,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+            }
+            .vk("vkGetQueryPoolResults")?;
+            let info = &self.ctx.info;
+            FrameReport::from_timestamps(
+                done.frame,
+                &done.pass_names,
+                &raw,
+                info.timestamp_valid_bits,
+                info.timestamp_period_ns,
+            )
+        } else {
+            // No timestamps on this device: passes are listed without GPU times.
+            FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
+        };
+        report.cpu_record_ns = done.cpu_record_ns;
+        report.cpu_submit_ns = done.cpu_submit_ns;
+        Ok(Some(report))
+    }
+
+    fn ensure_queries(&mut self, index: usize, needed: u32) -> Result<()> {
+        if !self.ctx.info.timestamps {
+            return Ok(());
+        }
+        let d = &self.ctx.device;
+        let slot = &mut self.slots[index];
+        if slot.query_capacity < needed {
+            if slot.queries != vk::QueryPool::null() {
+                unsafe { d.destroy_query_pool(slot.queries, None) };
+                slot.queries = vk::QueryPool::null();
+            }
+            let capacity = needed.next_power_of_two().max(64);
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::TIMESTAMP)
+                .query_count(capacity);
+            slot.queries = unsafe { d.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+            slot.query_capacity = capacity;
+        }
+        // Host reset (Vulkan 1.2 hostQueryReset): the slot's previous frame is retired.
+        unsafe { d.reset_query_pool(slot.queries, 0, slot.query_capacity) };
+        Ok(())
+    }
+
+    /// Creates images for pool slots that have none yet.
+    fn realize_pool(&mut self) -> Result<()> {
+        for s in self.pool_images.len()..self.pool.slot_count() {
+            let Some((desc, usage)) = self.pool.slot(s) else {
+                continue;
+            };
+            let image = Image::new(&self.ctx, &format!("transient#{s}"), desc, usage)?;
+            self.pool_images.push(Some(image));
+        }
+        Ok(())
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn resolve(
+        &self,
+        c: &Compiled,
+    ) -> Result<(Vec<Option<ResolvedImage>>, Vec<Option<vk::Buffer>>)> {
+        let mut images = Vec::with_capacity(c.graph.resources.len());
+        let mut buffers = Vec::with_capacity(c.graph.resources.len());
+        for (decl, planned) in c.graph.resources.iter().zip(&c.plan.resources) {
+            let (mut img, mut buf) = (None, None);
+            match (&decl.import, &decl.kind) {
+                (Some(import), _) => match &import.source {
+                    Imported::Image(i) => {
+                        img = Some(ResolvedImage {
+                            raw: i.raw,
+                            view: i.view,
+                            desc: i.desc,
+                        })
+                    }
+                    Imported::Buffer(b) => buf = Some(b.raw),
+                    Imported::Described { .. } => {
+                        return Err(Error::Graph(format!(
+                            "{:?} is only described and cannot be executed",
+                            decl.name
+                        )))
+                    }
+                },
+                (None, ResourceKind::Image(_)) => {
+                    if let Some(i) = planned
+                        .slot
+                        .and_then(|s| self.pool_images.get(s))
+                        .and_then(Option::as_ref)
+                    {
+                        img = Some(ResolvedImage {
+                            raw: i.raw,
+                            view: i.view,
+                            desc: i.desc,
+                        });
+                    }
+                }
+                (None, ResourceKind::Buffer(_)) => {}
+            }
+            images.push(img);
+            buffers.push(buf);
+        }
+        Ok((images, buffers))
+    }
+
+    /// Records passes `range` into the slot's command buffer; the first range of a
+    /// frame opens it (frame timestamp), the one reaching the end closes it
+    /// (final barriers, frame timestamp).
+    fn record(
+        &self,
+        index: usize,
+        c: &Compiled,
+        images: &[Option<ResolvedImage>],
+        buffers: &[Option<vk::Buffer>],
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
+        let first = range.start == 0;
+        let last = range.end == c.plan.passes.len();
+        let d = &self.ctx.device;
+        let slot = &self.slots[index];
+        let cmd = slot.cmd;
+        unsafe { d.reset_command_pool(slot.pool, vk::CommandPoolResetFlags::empty()) }
+            .vk("vkResetCommandPool")?;
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        unsafe { d.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
+        let timestamp = |q: u32| {
+            if self.clock == Clock::GpuTimestamp && slot.queries != vk::QueryPool::null() {
+                unsafe {
+                    d.cmd_write_timestamp2(
+                        cmd,
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        slot.queries,
+                        q,
+                    )
+                };
+            }
+        };
+        if first {
+            timestamp(0);
+        }
+        let cx = PassCx {
+            ctx: &self.ctx,
+            cmd,
+            images,
+            buffers,
+        };
+        for i in range {
+            let (planned, pass) = (&c.plan.passes[i], &c.graph.passes[i]);
+            self.label_begin(cmd, &planned.name);
+            self.barriers(cmd, &planned.barriers, images, buffers);
+            timestamp(2 + 2 * i as u32);
+            let rendering = !pass.attachments.is_empty();
+            if rendering {
+                self.begin_rendering(cmd, pass, images);
+            }
+            if let Some(record) = &pass.record {
+                record(&cx);
+            }
+            if rendering {
+                unsafe { d.cmd_end_rendering(cmd) };
+            }
+            timestamp(3 + 2 * i as u32);
+            self.label_end(cmd);
+        }
+        if last {
+            self.barriers(cmd, &c.plan.final_barriers, images, buffers);
+            timestamp(1);
+        }
+        unsafe { d.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")
+    }
+
+    fn barriers(
+        &self,
+        cmd: vk::CommandBuffer,
+        barriers: &[Barrier],
+        images: &[Option<ResolvedImage>],
+        buffers: &[Option<vk::Buffer>],
+    ) {
+        if barriers.is_empty() {
+            return;
+        }
+        let mut image_barriers = Vec::new();
+        let mut buffer_barriers = Vec::new();
+        for b in barriers {
+            match (b.layouts, images[b.resource], buffers[b.resource]) {
+                (Some((old, new)), Some(img), _) => image_barriers.push(
+                    vk::ImageMemoryBarrier2::default()
+                        .src_stage_mask(b.src_stage)
+                        .src_access_mask(b.src_access)
+                        .dst_stage_mask(b.dst_stage)
+                        .dst_access_mask(b.dst_access)
+                        .old_layout(old)
+                        .new_layout(new)
+                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .image(img.raw)
+                        .subresource_range(color_range(img.desc.mip_levels)),
+                ),
+                (None, _, Some(buffer)) => buffer_barriers.push(
+                    vk::BufferMemoryBarrier2::default()
+                        .src_stage_mask(b.src_stage)
+                        .src_access_mask(b.src_access)
+                        .dst_stage_mask(b.dst_stage)
+                        .dst_access_mask(b.dst_access)
+                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .buffer(buffer)
+                        .offset(0)
+                        .size(vk::WHOLE_SIZE),
+                ),
+                _ => {}
+            }
+        }
+        let dep = vk::DependencyInfo::default()
+            .image_memory_barriers(&image_barriers)
+            .buffer_memory_barriers(&buffer_barriers);
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    fn begin_rendering(
+        &self,
+        cmd: vk::CommandBuffer,
+        pass: &super::PassDecl,
+        images: &[Option<ResolvedImage>],
+    ) {
+        let attachment = |a: &super::Attachment| {
+            let img = images[a.resource].expect("attachments are images");
+            let (load_op, clear) = match a.load {
+                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
+                LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
+            };
+            let clear_value = if a.depth {
+                vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: clear[0],
+                        stencil: 0,
+                    },
+                }
+            } else {
+                vk::ClearValue {
+                    color: vk::ClearColorValue { float32: clear },
+                }
+            };
+            let layout = if a.depth {
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL
+            } else {
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+            };
+            let info = vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(layout)
+                .load_op(load_op)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(clear_value);
+            (info, img.desc.extent())
+        };
+        let colors: Vec<_> = pass
+            .attachments
+            .iter()
+            .filter(|a| !a.depth)
+            .map(|a| attachment(a).0)
+            .collect();
+        let depth = pass.attachments.iter().find(|a| a.depth).map(attachment);
+        let extent = pass
+            .attachments
+            .first()
+            .map(|a| attachment(a).1)
+            .unwrap_or_default();
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent,
+        };
+        let mut info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&colors);
+        if let Some((d, _)) = &depth {
+            info = info.depth_attachment(d);
+        }
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        unsafe {
+            let d = &self.ctx.device;
+            d.cmd_begin_rendering(cmd, &info);
+            d.cmd_set_viewport(cmd, 0, &[viewport]);
+            d.cmd_set_scissor(cmd, 0, &[area]);
+        }
+    }
+
+    fn label_begin(&self, cmd: vk::CommandBuffer, name: &str) {
+        let (Some(du), Ok(name)) = (&self.ctx.debug_utils, CString::new(name)) else {
+            return;
+        };
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+        unsafe { du.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    fn label_end(&self, cmd: vk::CommandBuffer) {
+        if let Some(du) = &self.ctx.debug_utils {
+            unsafe { du.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+}
+
+impl Drop for Executor {
+    fn drop(&mut self) {
+        for slot in &self.slots {
+            if slot.in_flight.is_some() {
+                let _ = unsafe {
+                    self.ctx
+                        .device
+                        .wait_for_fences(&[slot.fence], true, u64::MAX)
+                };
+            }
+        }
+        for slot in &self.slots {
+            self.destroy_slot(slot);
+        }
+    }
+}

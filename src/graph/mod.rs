@@ -1,0 +1,244 @@
+//! The render graph: passes declare what they read and write; the graph derives
+//! barriers, layouts, usage flags, transient lifetimes and pooling, then records.
+//! It knows nothing about skin.
+//!
+//! Building (`Graph`, `PassBuilder`) → compiling (`Graph::compile` → [`Plan`],
+//! plain data) → executing (`Executor::submit`). Writes take `&mut` handles and
+//! reads `&` handles (kajiya-rg), so the code shows who mutates what.
+
+mod access;
+mod execute;
+mod plan;
+
+pub use access::{Access, AccessInfo};
+pub use execute::{Clock, Compiled, Descriptor, Executor, PassCx, ResolvedImage};
+pub use plan::{Barrier, Plan, PlannedPass, PlannedResource, PoolState};
+
+use crate::gpu::{Buffer, Image, ImageDesc};
+use ash::vk;
+use std::sync::Arc;
+
+/// A graph image. Not `Copy`: writing needs `&mut`.
+#[derive(Debug)]
+pub struct ImageHandle {
+    id: usize,
+    pub desc: ImageDesc,
+}
+
+/// A graph buffer. Not `Copy`: writing needs `&mut`.
+#[derive(Debug)]
+pub struct BufferHandle {
+    id: usize,
+    pub size: u64,
+}
+
+/// What a pass's recording closure uses to name an image it declared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageRef(pub(crate) usize);
+
+/// What a pass's recording closure uses to name a buffer it declared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BufferRef(pub(crate) usize);
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadOp {
+    Clear([f32; 4]),
+    Load,
+    DontCare,
+}
+
+/// A resource owned outside the graph.
+pub enum Imported {
+    Image(Arc<Image>),
+    Buffer(Arc<Buffer>),
+    /// Only described: enough to plan (tests, `--dump-graph`), not to execute.
+    Described {
+        image: Option<ImageDesc>,
+        buffer_size: u64,
+        image_usage: vk::ImageUsageFlags,
+        buffer_usage: vk::BufferUsageFlags,
+    },
+}
+
+pub(crate) enum ResourceKind {
+    Image(ImageDesc),
+    Buffer(u64),
+}
+
+pub(crate) struct ResourceDecl {
+    pub name: String,
+    pub kind: ResourceKind,
+    pub import: Option<ImportDecl>,
+}
+
+pub(crate) struct ImportDecl {
+    pub source: Imported,
+    /// The access the resource was last used with before this graph (`None`: nothing
+    /// to wait for, contents undefined).
+    pub initial: Option<Access>,
+    /// The access to leave it ready for after the graph (e.g. `HostRead`).
+    pub final_access: Option<Access>,
+}
+
+pub(crate) struct Attachment {
+    pub resource: usize,
+    pub load: LoadOp,
+    pub depth: bool,
+}
+
+pub(crate) type RecordFn = Box<dyn Fn(&PassCx) + Send>;
+
+pub(crate) struct PassDecl {
+    pub name: String,
+    pub uses: Vec<(usize, Access)>,
+    pub attachments: Vec<Attachment>,
+    pub record: Option<RecordFn>,
+}
+
+#[derive(Default)]
+pub struct Graph {
+    pub(crate) resources: Vec<ResourceDecl>,
+    pub(crate) passes: Vec<PassDecl>,
+}
+
+impl Graph {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// An image that lives only within the frame; backed by the executor's pool.
+    pub fn create_image(&mut self, name: &str, desc: ImageDesc) -> ImageHandle {
+        self.resources.push(ResourceDecl {
+            name: name.into(),
+            kind: ResourceKind::Image(desc),
+            import: None,
+        });
+        ImageHandle {
+            id: self.resources.len() - 1,
+            desc,
+        }
+    }
+
+    pub fn import_image(
+        &mut self,
+        name: &str,
+        image: Imported,
+        initial: Option<Access>,
+        final_access: Option<Access>,
+    ) -> ImageHandle {
+        let desc = match &image {
+            Imported::Image(i) => i.desc,
+            Imported::Described { image: Some(d), .. } => *d,
+            _ => ImageDesc::new(0, 0, vk::Format::UNDEFINED),
+        };
+        self.resources.push(ResourceDecl {
+            name: name.into(),
+            kind: ResourceKind::Image(desc),
+            import: Some(ImportDecl {
+                source: image,
+                initial,
+                final_access,
+            }),
+        });
+        ImageHandle {
+            id: self.resources.len() - 1,
+            desc,
+        }
+    }
+
+    pub fn import_buffer(
+        &mut self,
+        name: &str,
+        buffer: Imported,
+        initial: Option<Access>,
+        final_access: Option<Access>,
+    ) -> BufferHandle {
+        let size = match &buffer {
+            Imported::Buffer(b) => b.size,
+            Imported::Described { buffer_size, .. } => *buffer_size,
+            Imported::Image(_) => 0,
+        };
+        self.resources.push(ResourceDecl {
+            name: name.into(),
+            kind: ResourceKind::Buffer(size),
+            import: Some(ImportDecl {
+                source: buffer,
+                initial,
+                final_access,
+            }),
+        });
+        BufferHandle {
+            id: self.resources.len() - 1,
+            size,
+        }
+    }
+
+    pub fn add_pass(&mut self, name: &str) -> PassBuilder<'_> {
+        PassBuilder {
+            graph: self,
+            pass: PassDecl {
+                name: name.into(),
+                uses: Vec::new(),
+                attachments: Vec::new(),
+                record: None,
+            },
+        }
+    }
+
+    pub fn pass_count(&self) -> usize {
+        self.passes.len()
+    }
+}
+
+pub struct PassBuilder<'g> {
+    graph: &'g mut Graph,
+    pass: PassDecl,
+}
+
+impl PassBuilder<'_> {
+    pub fn read(&mut self, image: &ImageHandle, access: Access) -> ImageRef {
+        self.pass.uses.push((image.id, access));
+        ImageRef(image.id)
+    }
+
+    pub fn write(&mut self, image: &mut ImageHandle, access: Access) -> ImageRef {
+        self.pass.uses.push((image.id, access));
+        ImageRef(image.id)
+    }
+
+    pub fn read_buffer(&mut self, buffer: &BufferHandle, access: Access) -> BufferRef {
+        self.pass.uses.push((buffer.id, access));
+        BufferRef(buffer.id)
+    }
+
+    pub fn write_buffer(&mut self, buffer: &mut BufferHandle, access: Access) -> BufferRef {
+        self.pass.uses.push((buffer.id, access));
+        BufferRef(buffer.id)
+    }
+
+    /// A colour attachment; the executor begins and ends dynamic rendering around
+    /// the pass and sets the viewport and scissor to the attachment's extent.
+    pub fn color_attachment(&mut self, image: &mut ImageHandle, load: LoadOp) -> ImageRef {
+        self.pass.attachments.push(Attachment {
+            resource: image.id,
+            load,
+            depth: false,
+        });
+        self.write(image, Access::ColorAttachment)
+    }
+
+    pub fn depth_attachment(&mut self, image: &mut ImageHandle, load: LoadOp) -> ImageRef {
+        self.pass.attachments.push(Attachment {
+            resource: image.id,
+            load,
+            depth: true,
+        });
+        self.write(image, Access::DepthAttachment)
+    }
+
+    /// Finishes the pass with the closure that records its commands.
+    pub fn record(mut self, f: impl Fn(&PassCx) + Send + 'static) {
+        self.pass.record = Some(Box::new(f));
+        self.graph.passes.push(self.pass);
+    }
+}

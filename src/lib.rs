@@ -1,0 +1,13 @@
+//! dermis: realistic real-time face rendering under environment lighting
+//! (Yang, Wang & Zuo 2012; d'Eon & Luebke, GPU Gems 3 ch. 14) on raw Vulkan,
+//! measured pass by pass.
+
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod profile;
+pub mod testscene;
+
+pub use error::{Error, Result};
+pub mod output;
+pub mod render;

@@ -1,0 +1,157 @@
+//! The `dermis` command line. Rendering logic lives in the library.
+
+use clap::{Parser, Subcommand};
+use dermis::gpu::{Context, ContextOptions};
+use dermis::render::{render, RenderOptions};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "dermis",
+    version,
+    about = "Realistic face rendering on Vulkan, measured pass by pass"
+)]
+struct Cli {
+    /// Use the first Vulkan device whose name contains this (case-insensitive).
+    #[arg(long, global = true, env = "DERMIS_DEVICE")]
+    device: Option<String>,
+    /// Enable the Khronos validation layer with synchronization validation.
+    #[arg(long, global = true)]
+    validation: bool,
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    verbose: u8,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Describe the Vulkan device dermis would use.
+    Info {
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Render the scene to an image.
+    Render {
+        /// Output image (.png).
+        #[arg(long, default_value = "dermis.png")]
+        out: PathBuf,
+        #[arg(long, default_value_t = 1024)]
+        width: u32,
+        #[arg(long, default_value_t = 1024)]
+        height: u32,
+        /// Frames to render; with more than one the first is warm-up.
+        #[arg(long, default_value_t = 1)]
+        frames: u32,
+        /// Print the per-pass GPU time table (median of measured frames).
+        #[arg(long)]
+        timings: bool,
+        /// Write the frame report (device, driver, per-pass GPU ns) as JSON.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// Print the compiled render graph (passes, barriers, lifetimes).
+        #[arg(long)]
+        dump_graph: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let level = match cli.verbose {
+        0 => "warn",
+        1 => "info",
+        _ => "debug",
+    };
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level)).init();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn run(cli: Cli) -> dermis::Result<()> {
+    let mut context = ContextOptions::from_env();
+    context.validation |= cli.validation;
+    context.device = cli.device.or(context.device);
+    match cli.command {
+        Command::Info { json } => {
+            let ctx = Context::new(&context)?;
+            let info = &ctx.info;
+            if json {
+                println!("{}", serde_json::to_string_pretty(info).unwrap_or_default());
+            } else {
+                println!("device:            {} ({})", info.name, info.device_type);
+                println!(
+                    "driver:            {} {}",
+                    info.driver_name, info.driver_info
+                );
+                println!("Vulkan:            {}", info.api_version);
+                println!(
+                    "timestamps:        {} (period {} ns, {} valid bits)",
+                    if info.timestamps { "yes" } else { "no" },
+                    info.timestamp_period_ns,
+                    info.timestamp_valid_bits
+                );
+                println!("max image size:    {}", info.max_image_dimension_2d);
+                for (i, h) in info.memory_heaps.iter().enumerate() {
+                    println!(
+                        "memory heap {i}:     {:.1} GiB{}",
+                        h.size_bytes as f64 / (1u64 << 30) as f64,
+                        if h.device_local {
+                            " (device local)"
+                        } else {
+                            ""
+                        }
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Render {
+            out,
+            width,
+            height,
+            frames,
+            timings,
+            report,
+            dump_graph,
+        } => {
+            let output = render(&RenderOptions {
+                width,
+                height,
+                frames,
+                context,
+            })?;
+            if dump_graph {
+                print!("{}", output.plan);
+            }
+            dermis::output::write_rgba8(&out, output.width, output.height, &output.rgba8)?;
+            if timings {
+                let r = &output.report;
+                println!(
+                    "{} ({}), {}x{}, {} frame(s), {} warm-up",
+                    r.device, r.driver, r.width, r.height, r.frames, r.warmup_frames
+                );
+                if let Some(m) = &r.median {
+                    print!("{}", m.table());
+                }
+            }
+            if let Some(path) = report {
+                let json = serde_json::to_string_pretty(&output.report)
+                    .map_err(|e| dermis::Error::Input(format!("{}: {e}", path.display())))?;
+                std::fs::write(&path, json).map_err(|source| dermis::Error::Io {
+                    path: path.display().to_string(),
+                    source,
+                })?;
+            }
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,228 @@
+//! Frame reports: per-pass GPU time from timestamps, CPU record/submit time, and
+//! medians over warmed-up frames.
+
+use serde::Serialize;
+
+/// GPU time of one pass of one frame.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassTime {
+    pub name: String,
+    /// `None` when the device has no timestamps or the delta was not positive.
+    pub gpu_ns: Option<f64>,
+}
+
+/// What one frame cost.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FrameReport {
+    pub frame: u64,
+    pub passes: Vec<PassTime>,
+    /// From a timestamp before the first pass to one after the last.
+    pub gpu_frame_ns: Option<f64>,
+    pub cpu_record_ns: f64,
+    pub cpu_submit_ns: f64,
+    /// Deltas that came out zero or negative and were dropped.
+    pub dropped_deltas: u32,
+    /// What measured the passes: "gpu-timestamp" or "host-fence".
+    pub clock: String,
+}
+
+impl FrameReport {
+    /// Sum of the passes' GPU times (≤ `gpu_frame_ns`: barriers and gaps are outside).
+    pub fn gpu_pass_sum_ns(&self) -> f64 {
+        self.passes.iter().filter_map(|p| p.gpu_ns).sum()
+    }
+
+    pub fn pass_ns(&self, name: &str) -> Option<f64> {
+        self.passes.iter().find(|p| p.name == name)?.gpu_ns
+    }
+
+    /// Turns raw 64-bit timestamps (frame begin, frame end, then begin/end per pass)
+    /// into durations: masked to `valid_bits`, scaled by `period_ns`.
+    pub fn from_timestamps(
+        frame: u64,
+        names: &[String],
+        raw: &[u64],
+        valid_bits: u32,
+        period_ns: f32,
+    ) -> Self {
+        let mask = if valid_bits >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << valid_bits) - 1
+        };
+        let mut dropped = 0;
+        let mut delta = |a: Option<&u64>, b: Option<&u64>| -> Option<f64> {
+            let (a, b) = (a? & mask, b? & mask);
+            if b <= a {
+                dropped += 1;
+                return None;
+            }
+            Some((b - a) as f64 * period_ns as f64)
+        };
+        let gpu_frame_ns = delta(raw.first(), raw.get(1));
+        let passes = names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| PassTime {
+                name: name.clone(),
+                gpu_ns: delta(raw.get(2 + 2 * i), raw.get(3 + 2 * i)),
+            })
+            .collect();
+        FrameReport {
+            frame,
+            passes,
+            gpu_frame_ns,
+            dropped_deltas: dropped,
+            clock: "gpu-timestamp".into(),
+            ..Default::default()
+        }
+    }
+
+    /// Per-pass medians over several frames (same pass list), e.g. after warm-up.
+    pub fn median(frames: &[FrameReport]) -> Option<FrameReport> {
+        let last = frames.last()?;
+        let med = |mut v: Vec<f64>| -> Option<f64> {
+            if v.is_empty() {
+                return None;
+            }
+            v.sort_by(f64::total_cmp);
+            let n = v.len();
+            Some(if n % 2 == 1 {
+                v[n / 2]
+            } else {
+                0.5 * (v[n / 2 - 1] + v[n / 2])
+            })
+        };
+        let passes = last
+            .passes
+            .iter()
+            .map(|p| PassTime {
+                name: p.name.clone(),
+                gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
+            })
+            .collect();
+        Some(FrameReport {
+            frame: last.frame,
+            passes,
+            gpu_frame_ns: med(frames.iter().filter_map(|f| f.gpu_frame_ns).collect()),
+            cpu_record_ns: med(frames.iter().map(|f| f.cpu_record_ns).collect()).unwrap_or(0.0),
+            cpu_submit_ns: med(frames.iter().map(|f| f.cpu_submit_ns).collect()).unwrap_or(0.0),
+            dropped_deltas: frames.iter().map(|f| f.dropped_deltas).sum(),
+            clock: last.clock.clone(),
+        })
+    }
+
+    /// A fixed-width table for terminals.
+    pub fn table(&self) -> String {
+        let ms = |ns: Option<f64>| ns.map_or("n/a".to_string(), |v| format!("{:.3}", v / 1e6));
+        let mut s = format!(
+            "{:<24} {:>12}   (clock: {})\n",
+            "pass", "GPU ms", self.clock
+        );
+        for p in &self.passes {
+            s += &format!("{:<24} {:>12}\n", p.name, ms(p.gpu_ns));
+        }
+        s += &format!(
+            "{:<24} {:>12}\n",
+            "sum of passes",
+            ms(Some(self.gpu_pass_sum_ns()))
+        );
+        s += &format!("{:<24} {:>12}\n", "frame (GPU span)", ms(self.gpu_frame_ns));
+        s += &format!(
+            "{:<24} {:>12}\n",
+            "CPU record",
+            ms(Some(self.cpu_record_ns))
+        );
+        s += &format!(
+            "{:<24} {:>12}\n",
+            "CPU submit",
+            ms(Some(self.cpu_submit_ns))
+        );
+        if self.dropped_deltas > 0 {
+            s += &format!(
+                "({} non-positive timestamp deltas dropped)\n",
+                self.dropped_deltas
+            );
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timestamps_are_masked_scaled_and_bad_deltas_dropped() {
+        let names = vec!["a".to_string(), "b".to_string()];
+        // 36 valid bits: the high garbage bit must be masked away.
+        let hi = 1u64 << 40;
+        let raw = [hi | 100, hi | 1100, 200, 600, 700, 700];
+        let r = FrameReport::from_timestamps(3, &names, &raw, 36, 2.0);
+        assert_eq!(r.gpu_frame_ns, Some(2000.0));
+        assert_eq!(r.pass_ns("a"), Some(800.0));
+        assert_eq!(r.pass_ns("b"), None);
+        assert_eq!(r.dropped_deltas, 1);
+    }
+
+    #[test]
+    fn median_per_pass() {
+        let f = |v: f64| FrameReport {
+            passes: vec![PassTime {
+                name: "p".into(),
+                gpu_ns: Some(v),
+            }],
+            gpu_frame_ns: Some(v * 2.0),
+            ..Default::default()
+        };
+        let m = FrameReport::median(&[f(5.0), f(1.0), f(3.0), f(100.0)]).unwrap();
+        assert_eq!(m.pass_ns("p"), Some(4.0));
+        assert_eq!(m.gpu_frame_ns, Some(8.0));
+    }
+}
+
+/// What `--report FILE.json` writes: the device, the setup, and the timings.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    pub device: String,
+    pub device_type: String,
+    pub driver: String,
+    pub api_version: String,
+    /// `LP_NUM_THREADS` (lavapipe's rasterizer thread count), when set.
+    pub lp_num_threads: Option<String>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub warmup_frames: usize,
+    /// Bytes of device memory held by pooled transient images.
+    pub transient_bytes: u64,
+    /// Per-pass medians over the measured (post-warm-up) frames.
+    pub median: Option<FrameReport>,
+    pub per_frame: Vec<FrameReport>,
+}
+
+impl RunReport {
+    pub fn new(
+        device: &crate::gpu::DeviceInfo,
+        width: u32,
+        height: u32,
+        per_frame: Vec<FrameReport>,
+        transient_bytes: u64,
+    ) -> Self {
+        let warmup = usize::from(per_frame.len() > 1);
+        Self {
+            device: device.name.clone(),
+            device_type: device.device_type.clone(),
+            driver: format!("{} {}", device.driver_name, device.driver_info),
+            api_version: device.api_version.clone(),
+            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+            width,
+            height,
+            frames: per_frame.len(),
+            warmup_frames: warmup,
+            transient_bytes,
+            median: FrameReport::median(&per_frame[warmup.min(per_frame.len())..]),
+            per_frame,
+        }
+    }
+}

@@ -1,0 +1,179 @@
+//! The interim scene `dermis render` draws until the face passes land: a
+//! procedural pattern through two compute blur passes and a graphics pass.
+
+use crate::error::Result;
+use crate::gpu::{Binding, Buffer, Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
+use crate::graph::{Access, Descriptor, Graph, ImageHandle, Imported, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BlurPush {
+    pub dir: [i32; 2],
+    pub radius: i32,
+    pub sigma: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CompositePush {
+    pub scale: f32,
+    pub bias: f32,
+    /// Pixels at x ≥ split_x are left untouched (discarded).
+    pub split_x: f32,
+    pub encode_srgb: u32,
+}
+
+/// Pipelines of the test scene; also used by tests to build their own chains.
+pub struct TestScene {
+    pub pattern: Arc<Pipeline>,
+    pub blur: Arc<Pipeline>,
+    /// Composite into RGBA8 (sRGB-encoded by the shader) for PNG output.
+    pub composite_rgba8: Arc<Pipeline>,
+    /// Composite into RGBA16F (linear), for exact checks.
+    pub composite_rgba16f: Arc<Pipeline>,
+    pub sampler: Arc<Sampler>,
+}
+
+pub const HALF: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+impl TestScene {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let composite = |format| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    vertex: "fullscreen.vert",
+                    fragment: "composite.frag",
+                    bindings: &[Binding::SampledImage],
+                    push_constant_bytes: std::mem::size_of::<CompositePush>() as u32,
+                    color_formats: &[format],
+                    depth_format: None,
+                    vertex_layout: None,
+                    cull_mode: vk::CullModeFlags::NONE,
+                },
+            )
+        };
+        Ok(Self {
+            pattern: Pipeline::compute(ctx, "pattern.comp", &[Binding::StorageImage], 8)?,
+            blur: Pipeline::compute(
+                ctx,
+                "blur.comp",
+                &[Binding::SampledImage, Binding::StorageImage],
+                std::mem::size_of::<BlurPush>() as u32,
+            )?,
+            composite_rgba8: composite(vk::Format::R8G8B8A8_UNORM)?,
+            composite_rgba16f: composite(HALF)?,
+            sampler: Arc::new(Sampler::clamped(ctx, false)?),
+        })
+    }
+
+    /// A separable blur (`radius` taps each side, Gaussian `sigma` in texels) of
+    /// `src` into a new transient image, as two compute passes.
+    pub fn blur(&self, g: &mut Graph, src: &ImageHandle, radius: i32, sigma: f32) -> ImageHandle {
+        let mut tmp = g.create_image("blur_tmp", src.desc);
+        let mut out = g.create_image("blurred", src.desc);
+        self.blur_pass(g, "blur_h", src, &mut tmp, [1, 0], radius, sigma);
+        self.blur_pass(g, "blur_v", &tmp, &mut out, [0, 1], radius, sigma);
+        out
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn blur_pass(
+        &self,
+        g: &mut Graph,
+        name: &str,
+        src: &ImageHandle,
+        dst: &mut ImageHandle,
+        dir: [i32; 2],
+        radius: i32,
+        sigma: f32,
+    ) {
+        let (w, h) = (dst.desc.width, dst.desc.height);
+        let mut p = g.add_pass(name);
+        let s = p.read(src, Access::ComputeSampled);
+        let d = p.write(dst, Access::ComputeStorageWrite);
+        let (pipe, sampler) = (self.blur.clone(), self.sampler.clone());
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(
+                &pipe,
+                &[
+                    Descriptor::Sampled(s, &sampler),
+                    Descriptor::StorageImage(d),
+                ],
+            );
+            cx.push_constants(&pipe, &BlurPush { dir, radius, sigma });
+            cx.dispatch_2d(w, h, (8, 8));
+        });
+    }
+
+    /// Composites `src` into `target` (a colour attachment) with `push`.
+    pub fn composite(
+        &self,
+        g: &mut Graph,
+        src: &ImageHandle,
+        target: &mut ImageHandle,
+        load: LoadOp,
+        push: CompositePush,
+    ) {
+        let pipe = if target.desc.format == HALF {
+            self.composite_rgba16f.clone()
+        } else {
+            self.composite_rgba8.clone()
+        };
+        let sampler = self.sampler.clone();
+        let mut p = g.add_pass("composite");
+        let s = p.read(src, Access::FragmentSampled);
+        p.color_attachment(target, load);
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(&pipe, &[Descriptor::Sampled(s, &sampler)]);
+            cx.push_constants(&pipe, &push);
+            cx.draw(3, 1);
+        });
+    }
+
+    /// The demo frame: pattern → blur_h → blur_v → composite (sRGB) → readback
+    /// into `readback` (width × height × 4 bytes, RGBA8).
+    pub fn frame(&self, g: &mut Graph, width: u32, height: u32, readback: &Arc<Buffer>) {
+        let mut pattern = g.create_image("pattern", ImageDesc::new(width, height, HALF));
+        let pipe = self.pattern.clone();
+        let mut p = g.add_pass("pattern");
+        let dst = p.write(&mut pattern, Access::ComputeStorageWrite);
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(&pipe, &[Descriptor::StorageImage(dst)]);
+            cx.push_constants(&pipe, &[width, height]);
+            cx.dispatch_2d(width, height, (8, 8));
+        });
+        let blurred = self.blur(g, &pattern, 6, 3.0);
+        let mut ldr = g.create_image(
+            "ldr",
+            ImageDesc::new(width, height, vk::Format::R8G8B8A8_UNORM),
+        );
+        let push = CompositePush {
+            scale: 1.0,
+            bias: 0.0,
+            split_x: f32::MAX,
+            encode_srgb: 1,
+        };
+        self.composite(g, &blurred, &mut ldr, LoadOp::DontCare, push);
+        readback_pass(g, &ldr, readback);
+    }
+}
+
+/// Copies `image` into a host-visible buffer and leaves it ready for the host.
+pub fn readback_pass(g: &mut Graph, image: &ImageHandle, buffer: &Arc<Buffer>) {
+    let mut out = g.import_buffer(
+        "readback",
+        Imported::Buffer(buffer.clone()),
+        Some(Access::HostRead),
+        Some(Access::HostRead),
+    );
+    let mut p = g.add_pass("readback");
+    let src = p.read(image, Access::TransferSrc);
+    let dst = p.write_buffer(&mut out, Access::TransferDst);
+    p.record(move |cx| cx.copy_image_to_buffer(src, dst));
+}
