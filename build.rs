@@ -103,14 +103,20 @@ fn main() {
                 // Stored as u32 words: 4-byte aligned, as ash::util::read_spv wants.
                 writeln!(table, "    ({name:?}, &{words:?}),").unwrap();
             }
-            // glslang's log already carries "ERROR: <file>:<line>: <message>".
-            Err(e) => failures.push(format!("{}:\n{e}", path.display())),
+            // glslang names the top-level source "0"; put the real path in its place.
+            Err(e) => failures.push(
+                e.lines()
+                    .filter(|l| l.starts_with("ERROR:") && !l.contains("compilation errors"))
+                    .map(|l| l.replacen("ERROR: 0:", &format!("{}:", path.display()), 1))
+                    .collect::<Vec<_>>()
+                    .join("\n"),
+            ),
         }
     }
     table.push_str("];\n");
     if !failures.is_empty() {
-        for f in &failures {
-            println!("cargo:warning={}", f.lines().next().unwrap_or_default());
+        for line in failures.iter().flat_map(|f| f.lines()) {
+            println!("cargo:warning={line}");
         }
         panic!("GLSL compilation failed:\n\n{}", failures.join("\n\n"));
     }

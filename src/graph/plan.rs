@@ -395,3 +395,371 @@ impl fmt::Display for BarrierDisplay<'_> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::{Graph, ImageHandle, Imported};
+    use vk::AccessFlags2 as A;
+    use vk::ImageLayout as L;
+    use vk::PipelineStageFlags2 as S;
+
+    const F: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+    fn image(g: &mut Graph, name: &str) -> ImageHandle {
+        g.create_image(name, ImageDesc::new(64, 64, F))
+    }
+
+    fn pass(
+        g: &mut Graph,
+        name: &str,
+        reads: &[(&ImageHandle, Access)],
+        writes: &mut [(&mut ImageHandle, Access)],
+    ) {
+        let mut p = g.add_pass(name);
+        for (h, a) in reads {
+            p.read(h, *a);
+        }
+        for (h, a) in writes.iter_mut() {
+            p.write(h, *a);
+        }
+        p.record(|_| {});
+    }
+
+    fn barriers_for(plan: &Plan, pass: usize, resource: usize) -> Vec<Barrier> {
+        plan.passes[pass]
+            .barriers
+            .iter()
+            .filter(|b| b.resource == resource)
+            .copied()
+            .collect()
+    }
+
+    #[test]
+    fn read_after_write_waits_for_the_write_and_transitions() {
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let mut b = image(&mut g, "b");
+        pass(
+            &mut g,
+            "write",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "read",
+            &[(&a, Access::ComputeSampled)],
+            &mut [(&mut b, Access::ComputeStorageWrite)],
+        );
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        let first = barriers_for(&plan, 0, 0);
+        assert_eq!(first.len(), 1);
+        assert_eq!(first[0].layouts, Some((L::UNDEFINED, L::GENERAL)));
+        assert_eq!(first[0].src_stage, S::NONE, "fresh slot waits for nothing");
+        let raw = barriers_for(&plan, 1, 0);
+        assert_eq!(raw.len(), 1);
+        let b0 = raw[0];
+        assert_eq!(
+            (b0.src_stage, b0.src_access),
+            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE)
+        );
+        assert_eq!(
+            (b0.dst_stage, b0.dst_access),
+            (S::COMPUTE_SHADER, A::SHADER_SAMPLED_READ)
+        );
+        assert_eq!(b0.layouts, Some((L::GENERAL, L::SHADER_READ_ONLY_OPTIMAL)));
+    }
+
+    #[test]
+    fn second_reader_in_same_stage_needs_no_barrier_other_stage_does() {
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let (mut b, mut c, mut d) = (image(&mut g, "b"), image(&mut g, "c"), image(&mut g, "d"));
+        pass(
+            &mut g,
+            "w",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "r1",
+            &[(&a, Access::ComputeSampled)],
+            &mut [(&mut b, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "r2",
+            &[(&a, Access::ComputeSampled)],
+            &mut [(&mut c, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "r3",
+            &[(&a, Access::FragmentSampled)],
+            &mut [(&mut d, Access::ColorAttachment)],
+        );
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        assert!(
+            barriers_for(&plan, 2, 0).is_empty(),
+            "read-after-read in the same stage"
+        );
+        let r3 = barriers_for(&plan, 3, 0);
+        assert_eq!(r3.len(), 1, "a new stage must wait too");
+        assert_eq!(r3[0].dst_stage, S::FRAGMENT_SHADER);
+        assert_eq!(
+            r3[0].layouts,
+            Some((L::SHADER_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL))
+        );
+        // Chains on the stage that performed the layout transition.
+        assert!(r3[0].src_stage.contains(S::COMPUTE_SHADER));
+    }
+
+    #[test]
+    fn write_after_read_waits_for_readers_without_access() {
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let mut b = image(&mut g, "b");
+        pass(
+            &mut g,
+            "w",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "r",
+            &[(&a, Access::FragmentSampled)],
+            &mut [(&mut b, Access::ColorAttachment)],
+        );
+        pass(&mut g, "w2", &[], &mut [(&mut a, Access::TransferDst)]);
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        let war = barriers_for(&plan, 2, 0);
+        assert_eq!(war.len(), 1);
+        assert!(war[0].src_stage.contains(S::FRAGMENT_SHADER));
+        assert_eq!(war[0].dst_access, A::TRANSFER_WRITE);
+        assert_eq!(
+            war[0].layouts,
+            Some((L::SHADER_READ_ONLY_OPTIMAL, L::TRANSFER_DST_OPTIMAL))
+        );
+    }
+
+    #[test]
+    fn write_after_write_in_same_layout_carries_the_write_access() {
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        pass(
+            &mut g,
+            "w1",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        pass(
+            &mut g,
+            "w2",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageReadWrite)],
+        );
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        let waw = barriers_for(&plan, 1, 0);
+        assert_eq!(waw.len(), 1);
+        assert_eq!(waw[0].src_access, A::SHADER_STORAGE_WRITE);
+        assert_eq!(waw[0].layouts, Some((L::GENERAL, L::GENERAL)));
+    }
+
+    #[test]
+    fn transients_with_disjoint_lifetimes_share_a_slot() {
+        // a → b → c → d, each written then sampled: same description and usage.
+        let mut g = Graph::new();
+        let mut imgs: Vec<ImageHandle> = ["a", "b", "c", "d"]
+            .iter()
+            .map(|n| image(&mut g, n))
+            .collect();
+        let mut last = image(&mut g, "last");
+        pass(
+            &mut g,
+            "wa",
+            &[],
+            &mut [(&mut imgs[0], Access::ComputeStorageWrite)],
+        );
+        for i in 1..4 {
+            let (src, dst) = imgs.split_at_mut(i);
+            pass(
+                &mut g,
+                "blur",
+                &[(&src[i - 1], Access::ComputeSampled)],
+                &mut [(&mut dst[0], Access::ComputeStorageWrite)],
+            );
+        }
+        pass(
+            &mut g,
+            "final",
+            &[(&imgs[3], Access::ComputeSampled)],
+            &mut [(&mut last, Access::ComputeStorageWrite)],
+        );
+        let mut pool = PoolState::default();
+        let plan = g.compile(&mut pool).unwrap();
+        let slots: Vec<_> = plan.resources.iter().map(|r| r.slot.unwrap()).collect();
+        assert_eq!(
+            &slots[..4],
+            &[0, 1, 0, 1],
+            "a chain needs only two live targets"
+        );
+        assert_ne!(slots[4], 0, "different usage, different slot");
+        // c's first barrier discards, but waits for a's last reader (a WAR on the memory).
+        let alias = barriers_for(&plan, 2, 2);
+        assert_eq!(alias[0].layouts, Some((L::UNDEFINED, L::GENERAL)));
+        assert!(alias[0].src_stage.contains(S::COMPUTE_SHADER));
+    }
+
+    #[test]
+    fn reuse_across_frames_waits_for_the_previous_frame() {
+        let build = || {
+            let mut g = Graph::new();
+            let mut a = image(&mut g, "a");
+            let mut out = g.import_image(
+                "out",
+                Imported::Described {
+                    image: Some(ImageDesc::new(64, 64, F)),
+                    buffer_size: 0,
+                    image_usage: vk::ImageUsageFlags::COLOR_ATTACHMENT,
+                    buffer_usage: vk::BufferUsageFlags::empty(),
+                },
+                None,
+                None,
+            );
+            pass(
+                &mut g,
+                "wa",
+                &[],
+                &mut [(&mut a, Access::ComputeStorageWrite)],
+            );
+            pass(
+                &mut g,
+                "draw",
+                &[(&a, Access::FragmentSampled)],
+                &mut [(&mut out, Access::ColorAttachment)],
+            );
+            g
+        };
+        let mut pool = PoolState::default();
+        let first = build().compile(&mut pool).unwrap();
+        let second = build().compile(&mut pool).unwrap();
+        assert_eq!(
+            pool.slot_count(),
+            1,
+            "the second frame reuses the pooled image"
+        );
+        assert_eq!(first.passes[0].barriers[0].src_stage, S::NONE);
+        let b = second.passes[0].barriers[0];
+        assert_eq!(b.layouts, Some((L::UNDEFINED, L::GENERAL)));
+        assert!(
+            b.src_stage.contains(S::FRAGMENT_SHADER),
+            "frame 2's write must wait for frame 1's sampling: {b:?}"
+        );
+    }
+
+    #[test]
+    fn imports_start_from_their_initial_access_and_end_in_their_final_one() {
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let mut buf = g.import_buffer(
+            "readback",
+            Imported::Described {
+                image: None,
+                buffer_size: 64 * 64 * 8,
+                image_usage: vk::ImageUsageFlags::empty(),
+                buffer_usage: vk::BufferUsageFlags::TRANSFER_DST,
+            },
+            Some(Access::HostRead),
+            Some(Access::HostRead),
+        );
+        pass(
+            &mut g,
+            "wa",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        let mut p = g.add_pass("copy");
+        p.read(&a, Access::TransferSrc);
+        p.write_buffer(&mut buf, Access::TransferDst);
+        p.record(|_| {});
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        let copy = barriers_for(&plan, 1, 1);
+        assert_eq!(copy[0].src_stage, S::HOST, "waits for the host's last read");
+        assert_eq!(copy[0].layouts, None);
+        let end = plan.final_barriers[0];
+        assert_eq!(
+            (end.src_access, end.dst_stage, end.dst_access),
+            (A::TRANSFER_WRITE, S::HOST, A::HOST_READ)
+        );
+    }
+
+    #[test]
+    fn declaration_errors_are_reported() {
+        let mut g = Graph::new();
+        let a = image(&mut g, "a");
+        let mut b = image(&mut g, "b");
+        pass(
+            &mut g,
+            "early read",
+            &[(&a, Access::ComputeSampled)],
+            &mut [(&mut b, Access::ComputeStorageWrite)],
+        );
+        let e = g
+            .compile(&mut PoolState::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("reads \"a\" before any pass writes it"), "{e}");
+
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let mut p = g.add_pass("twice");
+        p.write(&mut a, Access::ComputeStorageWrite);
+        p.write(&mut a, Access::TransferDst);
+        p.record(|_| {});
+        assert!(g.compile(&mut PoolState::default()).is_err());
+
+        let mut g = Graph::new();
+        let mut out = g.import_image(
+            "out",
+            Imported::Described {
+                image: Some(ImageDesc::new(8, 8, F)),
+                buffer_size: 0,
+                image_usage: vk::ImageUsageFlags::SAMPLED,
+                buffer_usage: vk::BufferUsageFlags::empty(),
+            },
+            None,
+            None,
+        );
+        pass(
+            &mut g,
+            "w",
+            &[],
+            &mut [(&mut out, Access::ComputeStorageWrite)],
+        );
+        let e = g
+            .compile(&mut PoolState::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lacks usage flags"), "{e}");
+    }
+
+    #[test]
+    fn failed_compile_leaves_the_pool_untouched() {
+        let mut pool = PoolState::default();
+        let mut g = Graph::new();
+        let mut a = image(&mut g, "a");
+        let b = image(&mut g, "b");
+        pass(
+            &mut g,
+            "w",
+            &[],
+            &mut [(&mut a, Access::ComputeStorageWrite)],
+        );
+        pass(&mut g, "bad", &[(&b, Access::ComputeSampled)], &mut []);
+        assert!(g.compile(&mut pool).is_err());
+        assert_eq!(pool.slot_count(), 0);
+    }
+}

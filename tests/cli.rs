@@ -1,0 +1,124 @@
+//! The command line as users run it, with validation on: outputs, reports, and
+//! clean failures (exit status 2, one line naming the problem) for bad input.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn dermis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dermis"))
+        .args(args)
+        .arg("--validation")
+        .output()
+        .expect("dermis runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dermis-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn assert_no_validation_messages(out: &Output) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !stderr.contains("[validation]"),
+        "validation messages:\n{stderr}"
+    );
+}
+
+#[test]
+fn render_writes_png_report_and_graph() {
+    let png = tmp("out.png");
+    let json = tmp("report.json");
+    let out = dermis(&[
+        "render",
+        "--out",
+        png.to_str().unwrap(),
+        "--width",
+        "80",
+        "--height",
+        "48",
+        "--frames",
+        "3",
+        "--timings",
+        "--dump-graph",
+        "--report",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("barrier"), "--dump-graph prints barriers");
+    assert!(
+        stdout.contains("frame (GPU span)"),
+        "--timings prints the table"
+    );
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (80, 48));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["frames"], 3);
+    assert_eq!(report["warmup_frames"], 1);
+    let passes = report["median"]["passes"].as_array().unwrap();
+    assert!(passes.iter().all(|p| p["gpu_ns"].as_f64().unwrap() > 0.0));
+    assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
+}
+
+#[test]
+fn info_json_describes_the_device() {
+    let out = dermis(&["info", "--json"]);
+    assert!(out.status.success());
+    assert_no_validation_messages(&out);
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(info["max_image_dimension_2d"].as_u64().unwrap() >= 4096);
+    assert_eq!(info["validation"], true);
+}
+
+#[test]
+fn target_larger_than_the_device_allows_is_a_clean_error() {
+    let out = dermis(&[
+        "render",
+        "--out",
+        tmp("big.png").to_str().unwrap(),
+        "--width",
+        "1000000",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_no_validation_messages(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("1000000x1024 is outside what"), "{stderr}");
+}
+
+#[test]
+fn unknown_output_format_is_a_clean_error() {
+    let out = dermis(&[
+        "render",
+        "--out",
+        tmp("x.bmp").to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("x.bmp") && stderr.contains("unsupported output format"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn unknown_device_is_a_clean_error() {
+    let out = dermis(&["info", "--device", "no-such-gpu-xyz"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("no-such-gpu-xyz") && stderr.contains("available"),
+        "{stderr}"
+    );
+}
