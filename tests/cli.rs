@@ -122,3 +122,21 @@ fn unknown_device_is_a_clean_error() {
         "{stderr}"
     );
 }
+
+#[test]
+fn no_driver_names_what_to_install() {
+    // The loader finds no driver: dermis must say what to install (no validation
+    // here: the loader itself reports the missing driver through the layer).
+    let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+        .arg("info")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .expect("dermis runs");
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("no Vulkan device found") && stderr.contains("mesa-vulkan-drivers"),
+        "{stderr}"
+    );
+}

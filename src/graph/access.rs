@@ -17,12 +17,16 @@ pub enum Access {
     VertexSampled,
     /// Sampled read in a fragment shader.
     FragmentSampled,
+    /// Sampled read in any shader stage: how static textures are left after upload.
+    ShaderSampled,
     /// Colour attachment (load, store, blend).
     ColorAttachment,
     /// Depth attachment (test and write).
     DepthAttachment,
     TransferSrc,
     TransferDst,
+    /// Blits within one image (mip generation); leaves it in TRANSFER_DST_OPTIMAL.
+    Blit,
     /// Storage buffer read in a compute shader.
     ComputeBufferRead,
     /// Storage buffer write in a compute shader.
@@ -80,6 +84,12 @@ impl Access {
                 L::SHADER_READ_ONLY_OPTIMAL,
                 false,
             ),
+            Access::ShaderSampled => (
+                S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::SHADER_SAMPLED_READ,
+                L::SHADER_READ_ONLY_OPTIMAL,
+                false,
+            ),
             Access::ColorAttachment => (
                 S::COLOR_ATTACHMENT_OUTPUT,
                 A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
@@ -96,6 +106,12 @@ impl Access {
             Access::TransferDst => (
                 S::COPY | S::CLEAR,
                 A::TRANSFER_WRITE,
+                L::TRANSFER_DST_OPTIMAL,
+                true,
+            ),
+            Access::Blit => (
+                S::BLIT,
+                A::TRANSFER_READ | A::TRANSFER_WRITE,
                 L::TRANSFER_DST_OPTIMAL,
                 true,
             ),
@@ -154,7 +170,10 @@ impl Access {
     pub fn image_usage(self) -> vk::ImageUsageFlags {
         use vk::ImageUsageFlags as U;
         match self {
-            Access::ComputeSampled | Access::VertexSampled | Access::FragmentSampled => U::SAMPLED,
+            Access::ComputeSampled
+            | Access::VertexSampled
+            | Access::FragmentSampled
+            | Access::ShaderSampled => U::SAMPLED,
             Access::ComputeStorageRead
             | Access::ComputeStorageWrite
             | Access::ComputeStorageReadWrite => U::STORAGE,
@@ -162,6 +181,7 @@ impl Access {
             Access::DepthAttachment => U::DEPTH_STENCIL_ATTACHMENT,
             Access::TransferSrc => U::TRANSFER_SRC,
             Access::TransferDst => U::TRANSFER_DST,
+            Access::Blit => U::TRANSFER_SRC | U::TRANSFER_DST,
             _ => U::empty(),
         }
     }

@@ -164,17 +164,22 @@ impl PassCx<'_> {
     }
 
     pub fn copy_image_to_buffer(&self, image: ImageRef, buffer: BufferRef) {
+        self.copy_level_to_buffer(image, 0, buffer);
+    }
+
+    /// Copies mip `level` of `image` into the start of `buffer`, tightly packed.
+    pub fn copy_level_to_buffer(&self, image: ImageRef, level: u32, buffer: BufferRef) {
         let img = self.image(image);
         let region = vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
                 aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
+                mip_level: level,
                 base_array_layer: 0,
                 layer_count: 1,
             })
             .image_extent(vk::Extent3D {
-                width: img.desc.width,
-                height: img.desc.height,
+                width: (img.desc.width >> level).max(1),
+                height: (img.desc.height >> level).max(1),
                 depth: 1,
             });
         unsafe {
@@ -211,6 +216,92 @@ impl PassCx<'_> {
                 &[region],
             )
         };
+    }
+
+    /// Fills mip levels 1.. from level 0 by successive linear blits, for a pass
+    /// that declared [`Access::Blit`](super::Access::Blit). The per-level barriers
+    /// between blits are internal to this pass; all levels end in
+    /// TRANSFER_DST_OPTIMAL, as the graph expects after `Blit`.
+    pub fn generate_mips(&self, image: ImageRef) {
+        use vk::AccessFlags2 as A;
+        use vk::ImageLayout as L;
+        use vk::PipelineStageFlags2 as S;
+        let img = self.image(image);
+        let levels = img.desc.mip_levels;
+        let level = |base: u32, count: u32| vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: base,
+            level_count: count,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let barrier = |range, old, new, src_access, dst_access| {
+            vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(S::BLIT | S::COPY)
+                .src_access_mask(src_access)
+                .dst_stage_mask(S::BLIT)
+                .dst_access_mask(dst_access)
+                .old_layout(old)
+                .new_layout(new)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(img.raw)
+                .subresource_range(range)
+        };
+        let d = self.device();
+        let (mut w, mut h) = (img.desc.width as i32, img.desc.height as i32);
+        for i in 1..levels {
+            let to_src = [barrier(
+                level(i - 1, 1),
+                L::TRANSFER_DST_OPTIMAL,
+                L::TRANSFER_SRC_OPTIMAL,
+                A::TRANSFER_WRITE,
+                A::TRANSFER_READ,
+            )];
+            unsafe {
+                d.cmd_pipeline_barrier2(
+                    self.cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&to_src),
+                )
+            };
+            let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+            let layers = |mip| vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: mip,
+                base_array_layer: 0,
+                layer_count: 1,
+            };
+            let region = vk::ImageBlit2::default()
+                .src_subresource(layers(i - 1))
+                .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
+                .dst_subresource(layers(i))
+                .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: nw, y: nh, z: 1 }]);
+            let regions = [region];
+            let blit = vk::BlitImageInfo2::default()
+                .src_image(img.raw)
+                .src_image_layout(L::TRANSFER_SRC_OPTIMAL)
+                .dst_image(img.raw)
+                .dst_image_layout(L::TRANSFER_DST_OPTIMAL)
+                .regions(&regions)
+                .filter(vk::Filter::LINEAR);
+            unsafe { d.cmd_blit_image2(self.cmd, &blit) };
+            (w, h) = (nw, nh);
+        }
+        if levels > 1 {
+            let back = [barrier(
+                level(0, levels - 1),
+                L::TRANSFER_SRC_OPTIMAL,
+                L::TRANSFER_DST_OPTIMAL,
+                A::NONE,
+                A::TRANSFER_READ | A::TRANSFER_WRITE,
+            )];
+            unsafe {
+                d.cmd_pipeline_barrier2(
+                    self.cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&back),
+                )
+            };
+        }
     }
 
     pub fn clear_image(&self, image: ImageRef, rgba: [f32; 4]) {

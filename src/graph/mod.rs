@@ -9,6 +9,7 @@
 mod access;
 mod execute;
 mod plan;
+pub mod upload;
 
 pub use access::{Access, AccessInfo};
 pub use execute::{Clock, Compiled, Descriptor, Executor, PassCx, ResolvedImage};
