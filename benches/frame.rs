@@ -1,11 +1,14 @@
-//! Per-pass GPU cost of the frame at several resolutions: medians over warmed-up
-//! frames (the first frame of each size is warm-up: lavapipe compiles shaders on
-//! first use). `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 6) and
+//! Per-pass GPU cost of the default frame (built-in head under the sky) at
+//! several output sizes: medians over warmed-up frames (the first frame of each
+//! size is warm-up: lavapipe compiles shaders on first use).
+//! `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 6) and
 //! `DERMIS_BENCH_SIZES` (default "512,1024,2048") tune it. Writes
 //! `target/bench-frame.json` for docs/performance.md.
 
 use dermis::gpu::{Context, ContextOptions};
-use dermis::render::{render_with, RenderOptions};
+use dermis::render::{render_scene, RenderOptions};
+use dermis::scene::file::SceneFile;
+use dermis::scene::Scene;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: u32 = std::env::var("DERMIS_BENCH_FRAMES")
@@ -18,16 +21,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     let ctx = Context::new(&ContextOptions::from_env())?;
+    let mut scene = Scene::load(SceneFile::default())?;
     let mut reports = Vec::new();
     for size in sizes {
+        scene.file.render.width = size;
+        scene.file.render.height = size;
         let opts = RenderOptions {
-            width: size,
-            height: size,
             frames: frames.max(2),
-            context: ContextOptions::from_env(),
+            ..RenderOptions::default()
         };
-        let out = render_with(&ctx, &opts)?;
-        let r = out.report;
+        let r = render_scene(&ctx, &scene, &opts)?.report;
         println!(
             "\n{size}x{size} on {} ({}), {} measured frames, LP_NUM_THREADS={}",
             r.device,

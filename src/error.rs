@@ -35,6 +35,10 @@ pub enum Error {
     /// Bad user input (files, sizes, options): exit status 2.
     #[error("{0}")]
     Input(String),
+    #[error(transparent)]
+    Scene(#[from] crate::scene::file::SceneError),
+    #[error(transparent)]
+    Env(#[from] crate::light::envmap::EnvError),
     #[error("{path}: {source}")]
     Io {
         path: String,
@@ -46,7 +50,11 @@ impl Error {
     /// Process exit status: 2 for bad input, 1 for everything else.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Input(_) | Error::Io { .. } | Error::DeviceNotFound { .. } => 2,
+            Error::Input(_)
+            | Error::Io { .. }
+            | Error::DeviceNotFound { .. }
+            | Error::Scene(_)
+            | Error::Env(_) => 2,
             _ => 1,
         }
     }

@@ -5,9 +5,13 @@
 pub mod error;
 pub mod gpu;
 pub mod graph;
+pub mod light;
 pub mod profile;
+pub mod scene;
+pub mod skin;
 pub mod testscene;
 
 pub use error::{Error, Result};
 pub mod output;
+pub mod post;
 pub mod render;

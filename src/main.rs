@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions};
+use dermis::scene::file::{load_scene, SceneFile};
+use dermis::scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,15 +36,37 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Render the scene to an image.
+    /// Render the scene to an image (the built-in head under the sky by default).
     Render {
-        /// Output image (.png).
+        /// TOML scene file (see docs/scene-format.md).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Output image: .png (8-bit sRGB) or .exr (linear float).
         #[arg(long, default_value = "dermis.png")]
         out: PathBuf,
-        #[arg(long, default_value_t = 1024)]
-        width: u32,
-        #[arg(long, default_value_t = 1024)]
-        height: u32,
+        /// glTF mesh (.glb/.gltf), replacing the scene's.
+        #[arg(long)]
+        mesh: Option<PathBuf>,
+        /// Millimetres per mesh unit (e.g. 50.3 for the Lee Perry-Smith scan).
+        #[arg(long)]
+        mm_per_unit: Option<f32>,
+        /// Environment: a .hdr/.exr file, `sky[:elevation=..,azimuth=..,turbidity=..]`
+        /// or `uniform:R,G,B`.
+        #[arg(long)]
+        env: Option<String>,
+        /// Environment rotation about +Y, degrees.
+        #[arg(long, allow_hyphen_values = true)]
+        env_rotate: Option<f32>,
+        /// Exposure in EV stops.
+        #[arg(long, allow_hyphen_values = true)]
+        exposure: Option<f32>,
+        /// Side of the UV-space irradiance texture (power of two, 256..8192).
+        #[arg(long)]
+        irradiance_res: Option<u32>,
+        #[arg(long)]
+        width: Option<u32>,
+        #[arg(long)]
+        height: Option<u32>,
         /// Frames to render; with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
@@ -114,7 +138,14 @@ fn run(cli: Cli) -> dermis::Result<()> {
             Ok(())
         }
         Command::Render {
+            scene,
             out,
+            mesh,
+            mm_per_unit,
+            env,
+            env_rotate,
+            exposure,
+            irradiance_res,
             width,
             height,
             frames,
@@ -122,16 +153,31 @@ fn run(cli: Cli) -> dermis::Result<()> {
             report,
             dump_graph,
         } => {
-            let output = render(&RenderOptions {
+            let file = match &scene {
+                Some(path) => load_scene(path)?,
+                None => SceneFile::default(),
+            };
+            let overrides = Overrides {
+                mesh,
+                mm_per_unit,
+                env,
+                env_rotate_deg: env_rotate,
+                exposure,
+                irradiance_resolution: irradiance_res,
                 width,
                 height,
+            };
+            let hdr = dermis::output::Format::of(&out)? == dermis::output::Format::Exr;
+            let output = render(&RenderOptions {
+                scene: overrides.apply(file)?,
                 frames,
+                hdr,
                 context,
             })?;
             if dump_graph {
                 print!("{}", output.plan);
             }
-            dermis::output::write_rgba8(&out, output.width, output.height, &output.rgba8)?;
+            dermis::output::write(&out, &output)?;
             if timings {
                 let r = &output.report;
                 println!(

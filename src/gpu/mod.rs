@@ -9,8 +9,8 @@ mod validation;
 
 pub use context::{Context, ContextOptions, DeviceInfo, MemoryHeap};
 pub use pipeline::{Binding, GraphicsDesc, Pipeline};
-pub(crate) use resources::color_range;
-pub use resources::{texel_bytes, Buffer, Image, ImageDesc, Sampler};
+pub(crate) use resources::full_range;
+pub use resources::{aspect, texel_bytes, Buffer, Image, ImageDesc, Sampler};
 pub use validation::ValidationLog;
 
 pub use gpu_allocator::MemoryLocation;

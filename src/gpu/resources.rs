@@ -38,7 +38,10 @@ impl ImageDesc {
 pub fn texel_bytes(format: vk::Format) -> Option<u32> {
     Some(match format {
         vk::Format::R8_UNORM => 1,
-        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::R32_SFLOAT => 4,
+        vk::Format::R8G8B8A8_UNORM
+        | vk::Format::R8G8B8A8_SRGB
+        | vk::Format::R32_SFLOAT
+        | vk::Format::D32_SFLOAT => 4,
         vk::Format::R16G16B16A16_SFLOAT | vk::Format::R32G32_SFLOAT => 8,
         vk::Format::R32G32B32A32_SFLOAT => 16,
         _ => return None,
@@ -115,7 +118,7 @@ impl Image {
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(desc.format)
-            .subresource_range(color_range(desc.mip_levels));
+            .subresource_range(full_range(desc.format, desc.mip_levels));
         image.view =
             unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         ctx.name(raw, name);
@@ -124,9 +127,18 @@ impl Image {
     }
 }
 
-pub(crate) fn color_range(mip_levels: u32) -> vk::ImageSubresourceRange {
+/// The aspect an image of `format` is viewed and synchronised with.
+pub fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM => vk::ImageAspectFlags::DEPTH,
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+/// Every mip level of an image of `format`.
+pub(crate) fn full_range(format: vk::Format, mip_levels: u32) -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange {
-        aspect_mask: vk::ImageAspectFlags::COLOR,
+        aspect_mask: aspect(format),
         base_mip_level: 0,
         level_count: mip_levels,
         base_array_layer: 0,

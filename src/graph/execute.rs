@@ -4,7 +4,7 @@
 use super::plan::{Barrier, Plan, PoolState};
 use super::{BufferRef, Graph, ImageRef, Imported, LoadOp, ResourceKind};
 use crate::error::{Error, Result, VkResultExt};
-use crate::gpu::{color_range, Context, Image, ImageDesc, Pipeline, Sampler};
+use crate::gpu::{full_range, Buffer, Context, Image, ImageDesc, Pipeline, Sampler};
 use crate::profile::{FrameReport, PassTime};
 use ash::vk;
 use std::ffi::CString;
@@ -34,6 +34,8 @@ pub enum Descriptor<'a> {
     StaticSampled(&'a Image, &'a Sampler),
     Uniform(BufferRef),
     Storage(BufferRef),
+    /// A static uniform buffer outside the graph (uploaded with final access `UniformRead`).
+    StaticUniform(&'a Buffer),
 }
 
 /// What a pass's closure records with.
@@ -91,6 +93,11 @@ impl PassCx<'_> {
                         range: vk::WHOLE_SIZE,
                     })
                 }
+                Descriptor::StaticUniform(b) => buffer_infos.push(vk::DescriptorBufferInfo {
+                    buffer: b.raw,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }),
             }
         }
         let (mut ii, mut bi) = (0, 0);
@@ -100,12 +107,15 @@ impl PassCx<'_> {
             .map(|(binding, d)| {
                 let w = vk::WriteDescriptorSet::default().dst_binding(binding as u32);
                 match d {
-                    Descriptor::Uniform(_) | Descriptor::Storage(_) => {
-                        let ty = if matches!(d, Descriptor::Uniform(_)) {
-                            vk::DescriptorType::UNIFORM_BUFFER
-                        } else {
-                            vk::DescriptorType::STORAGE_BUFFER
-                        };
+                    Descriptor::Uniform(_)
+                    | Descriptor::Storage(_)
+                    | Descriptor::StaticUniform(_) => {
+                        let ty =
+                            if matches!(d, Descriptor::Uniform(_) | Descriptor::StaticUniform(_)) {
+                                vk::DescriptorType::UNIFORM_BUFFER
+                            } else {
+                                vk::DescriptorType::STORAGE_BUFFER
+                            };
                         bi += 1;
                         w.descriptor_type(ty)
                             .buffer_info(std::slice::from_ref(&buffer_infos[bi - 1]))
@@ -156,6 +166,29 @@ impl PassCx<'_> {
                 height.div_ceil(local.1),
                 1,
             )
+        };
+    }
+
+    /// Binds a static vertex buffer (uploaded with final access `VertexBuffer`).
+    pub fn bind_vertex_buffer(&self, buffer: &Buffer) {
+        unsafe {
+            self.device()
+                .cmd_bind_vertex_buffers(self.cmd, 0, &[buffer.raw], &[0])
+        };
+    }
+
+    /// Binds a static u32 index buffer (uploaded with final access `IndexBuffer`).
+    pub fn bind_index_buffer(&self, buffer: &Buffer) {
+        unsafe {
+            self.device()
+                .cmd_bind_index_buffer(self.cmd, buffer.raw, 0, vk::IndexType::UINT32)
+        };
+    }
+
+    pub fn draw_indexed(&self, indices: u32, instances: u32) {
+        unsafe {
+            self.device()
+                .cmd_draw_indexed(self.cmd, indices, instances, 0, 0, 0)
         };
     }
 
@@ -313,7 +346,7 @@ impl PassCx<'_> {
                 img.raw,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &value,
-                &[color_range(img.desc.mip_levels)],
+                &[full_range(img.desc.format, img.desc.mip_levels)],
             )
         };
     }
@@ -789,7 +822,7 @@ impl Executor {
                         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                         .image(img.raw)
-                        .subresource_range(color_range(img.desc.mip_levels)),
+                        .subresource_range(full_range(img.desc.format, img.desc.mip_levels)),
                 ),
                 (None, _, Some(buffer)) => buffer_barriers.push(
                     vk::BufferMemoryBarrier2::default()

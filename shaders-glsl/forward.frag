@@ -1,0 +1,34 @@
+#version 460
+// Diffuse shading of the mesh: albedo/π × (SH environment irradiance + directional
+// lights), with the tangent-space normal map. Replaced by texture-space diffusion
+// in the skin passes; kept as the `diffuse-direct` view.
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+#include "sh.glsl"
+const float PI_F = 3.14159265358979;
+layout(binding = 1) uniform sampler2D albedo_tex;   // sRGB format: sampled linear
+layout(binding = 2) uniform sampler2D normal_tex;   // tangent space, [0,1] encoded
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec2 v_uv;
+layout(location = 3) in vec4 v_tangent;
+layout(location = 0) out vec4 color;
+
+vec3 shading_normal() {
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
+    vec3 b = cross(n, t) * v_tangent.w;
+    vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
+    vec3 s = normalize(m.x * t + m.y * b + m.z * n);
+    return gl_FrontFacing ? s : -s;
+}
+
+void main() {
+    vec3 n = shading_normal();
+    vec3 e = max(sh_irradiance(frame.sh, n), vec3(0.0));
+    for (int i = 0; i < int(frame.env.z); ++i) {
+        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
+    }
+    vec3 albedo = texture(albedo_tex, v_uv).rgb;
+    color = vec4(albedo / PI_F * e, 1.0);
+}

@@ -1,0 +1,6 @@
+//! Environment lighting: environment maps and the built-in sky, spherical
+//! harmonics (Ramamoorthi & Hanrahan 2001; the paper's section III).
+
+pub mod envmap;
+pub mod sh;
+pub mod sky;

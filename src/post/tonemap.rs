@@ -1,0 +1,47 @@
+//! Exposure (EV stops) and the sRGB transfer function into an 8-bit target.
+
+use crate::error::Result;
+use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline, Sampler};
+use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+
+pub struct Tonemap {
+    pipeline: Arc<Pipeline>,
+    sampler: Arc<Sampler>,
+}
+
+impl Tonemap {
+    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "fullscreen.vert",
+                fragment: "tonemap.frag",
+                bindings: &[Binding::SampledImage],
+                push_constant_bytes: 4,
+                color_formats: &[LDR_FORMAT],
+                depth_format: None,
+                vertex_layout: None,
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(Self { pipeline, sampler })
+    }
+
+    /// `hdr` × 2^exposure, sRGB-encoded, into `ldr`.
+    pub fn pass(&self, g: &mut Graph, hdr: &ImageHandle, ldr: &mut ImageHandle, exposure: f32) {
+        let mut p = g.add_pass("tonemap");
+        let src = p.read(hdr, Access::FragmentSampled);
+        p.color_attachment(ldr, LoadOp::DontCare);
+        let (pipe, sampler) = (self.pipeline.clone(), self.sampler.clone());
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(&pipe, &[Descriptor::Sampled(src, &sampler)]);
+            cx.push_constants(&pipe, &exposure);
+            cx.draw(3, 1);
+        });
+    }
+}

@@ -1,0 +1,128 @@
+//! Screen-space scene passes: the environment behind the head, and the mesh with
+//! direct diffuse shading (the `diffuse-direct` path until the skin passes land).
+
+use super::resources::{MeshBuffers, Samplers, Vertex, VERTEX_ATTRIBUTES};
+use crate::error::Result;
+use crate::gpu::{Binding, Buffer, Context, GraphicsDesc, Image, Pipeline};
+use crate::graph::{Descriptor, Graph, ImageHandle, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+/// Formats of the screen-space targets.
+pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// Per-frame uniforms (std140, mirrors shaders-glsl/common/frame.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub sh: [[f32; 4]; 9],
+    pub light_dir: [[f32; 4]; 4],
+    pub light_color: [[f32; 4]; 4],
+    /// x: environment rotation (radians about +Y), y: intensity, z: light count.
+    pub env: [f32; 4],
+    /// x: exposure (EV).
+    pub params: [f32; 4],
+}
+
+pub const MAX_LIGHTS: usize = 4;
+
+pub struct ForwardPipelines {
+    background: Arc<Pipeline>,
+    mesh: Arc<Pipeline>,
+}
+
+impl ForwardPipelines {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let background = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "fullscreen.vert",
+                fragment: "background.frag",
+                bindings: &[Binding::UniformBuffer, Binding::SampledImage],
+                push_constant_bytes: 8,
+                color_formats: &[HDR_FORMAT],
+                depth_format: None,
+                vertex_layout: None,
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        let mesh = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "mesh.vert",
+                fragment: "forward.frag",
+                bindings: &[
+                    Binding::UniformBuffer,
+                    Binding::SampledImage,
+                    Binding::SampledImage,
+                ],
+                push_constant_bytes: 0,
+                color_formats: &[HDR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+                // Scanned meshes are not reliably closed or consistently wound.
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(Self { background, mesh })
+    }
+}
+
+/// Static inputs of the forward passes.
+pub struct ForwardInputs {
+    pub uniforms: Arc<Buffer>,
+    pub mesh: Arc<MeshBuffers>,
+    pub albedo: Arc<Image>,
+    pub normal: Arc<Image>,
+    pub env: Arc<Image>,
+    pub samplers: Arc<Samplers>,
+}
+
+/// Environment background, then the mesh over it, into `hdr`.
+pub fn passes(
+    g: &mut Graph,
+    p: &ForwardPipelines,
+    inputs: &Arc<ForwardInputs>,
+    hdr: &mut ImageHandle,
+) {
+    let (w, h) = (hdr.desc.width, hdr.desc.height);
+    let mut pass = g.add_pass("background");
+    pass.color_attachment(hdr, LoadOp::Clear([0.0; 4]));
+    let (pipe, inp) = (p.background.clone(), inputs.clone());
+    pass.record(move |cx| {
+        cx.bind(&pipe);
+        cx.push_descriptors(
+            &pipe,
+            &[
+                Descriptor::StaticUniform(&inp.uniforms),
+                Descriptor::StaticSampled(&inp.env, &inp.samplers.nearest),
+            ],
+        );
+        cx.push_constants(&pipe, &[w as f32, h as f32]);
+        cx.draw(3, 1);
+    });
+
+    let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
+    let mut pass = g.add_pass("mesh");
+    pass.color_attachment(hdr, LoadOp::Load);
+    pass.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
+    let (pipe, inp) = (p.mesh.clone(), inputs.clone());
+    pass.record(move |cx| {
+        cx.bind(&pipe);
+        cx.push_descriptors(
+            &pipe,
+            &[
+                Descriptor::StaticUniform(&inp.uniforms),
+                Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
+                Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
+            ],
+        );
+        cx.bind_vertex_buffer(&inp.mesh.vertices);
+        cx.bind_index_buffer(&inp.mesh.indices);
+        cx.draw_indexed(inp.mesh.index_count, 1);
+    });
+}

@@ -1,0 +1,106 @@
+//! The scene on the GPU: vertex and index buffers, textures (with GPU mips), the
+//! environment map, the per-frame uniforms and samplers.
+
+use crate::error::Result;
+use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
+use crate::graph::upload::{full_mip_count, upload_buffer, upload_texture};
+use crate::graph::Access;
+use crate::light::envmap::EnvMap;
+use crate::scene::mesh::Mesh;
+use crate::scene::texture::{Encoding, Texture};
+use ash::vk;
+use std::sync::Arc;
+
+/// Interleaved vertex: position (mm), normal, uv, tangent (w = bitangent sign).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+    pub tangent: [f32; 4],
+}
+
+/// The vertex layout the mesh pipelines declare: (format, offset) per location.
+pub const VERTEX_ATTRIBUTES: [(vk::Format, u32); 4] = [
+    (vk::Format::R32G32B32_SFLOAT, 0),
+    (vk::Format::R32G32B32_SFLOAT, 12),
+    (vk::Format::R32G32_SFLOAT, 24),
+    (vk::Format::R32G32B32A32_SFLOAT, 32),
+];
+
+pub struct MeshBuffers {
+    pub vertices: Arc<Buffer>,
+    pub indices: Arc<Buffer>,
+    pub index_count: u32,
+}
+
+impl MeshBuffers {
+    pub fn upload(ctx: &Arc<Context>, mesh: &Mesh) -> Result<Self> {
+        mesh.validate()
+            .map_err(|m| crate::Error::Input(format!("mesh {:?}: {m}", mesh.name)))?;
+        let vertices: Vec<Vertex> = (0..mesh.vertex_count())
+            .map(|i| Vertex {
+                position: mesh.positions[i].into(),
+                normal: mesh.normals[i].into(),
+                uv: mesh.uvs[i].into(),
+                tangent: mesh.tangents[i].into(),
+            })
+            .collect();
+        Ok(Self {
+            vertices: upload_buffer(
+                ctx,
+                "vertices",
+                bytemuck::cast_slice(&vertices),
+                Access::VertexBuffer,
+            )?,
+            indices: upload_buffer(
+                ctx,
+                "indices",
+                bytemuck::cast_slice(&mesh.indices),
+                Access::IndexBuffer,
+            )?,
+            index_count: mesh.indices.len() as u32,
+        })
+    }
+}
+
+/// An RGBA8 texture with a full GPU-generated mip chain; sRGB maps get an
+/// `_SRGB` format so shaders sample linear values.
+pub fn upload_rgba8(ctx: &Arc<Context>, name: &str, t: &Texture) -> Result<Arc<Image>> {
+    let format = match t.encoding {
+        Encoding::Srgb => vk::Format::R8G8B8A8_SRGB,
+        Encoding::Linear => vk::Format::R8G8B8A8_UNORM,
+    };
+    let desc = ImageDesc {
+        mip_levels: full_mip_count(t.width, t.height),
+        ..ImageDesc::new(t.width, t.height, format)
+    };
+    upload_texture(ctx, name, desc, &t.rgba8)
+}
+
+/// The environment as RGBA32F: the sky's sun disk (~1e6 kcd/m²) does not fit
+/// in half floats (max 65504).
+pub fn upload_env(ctx: &Arc<Context>, env: &EnvMap) -> Result<Arc<Image>> {
+    let texels: Vec<f32> = env
+        .texels
+        .iter()
+        .flat_map(|c| [c.x, c.y, c.z, 1.0])
+        .collect();
+    let desc = ImageDesc::new(env.width, env.height, vk::Format::R32G32B32A32_SFLOAT);
+    upload_texture(ctx, "environment", desc, bytemuck::cast_slice(&texels))
+}
+
+pub struct Samplers {
+    pub linear: Arc<Sampler>,
+    pub nearest: Arc<Sampler>,
+}
+
+impl Samplers {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        Ok(Self {
+            linear: Arc::new(Sampler::clamped(ctx, true)?),
+            nearest: Arc::new(Sampler::clamped(ctx, false)?),
+        })
+    }
+}

@@ -1,0 +1,1200 @@
+//! The TOML scene file: which mesh, maps, lighting, camera, skin parameters and
+//! render settings to use. Every field is optional; `docs/scene-format.md` lists
+//! each one with its unit, default, valid range and the source of the default.
+//!
+//! [`load_scene`] parses, checks every value ([`SceneFile::validate`]) and resolves
+//! relative paths against the scene file's directory. Errors are [`SceneError`]s:
+//! one line that names the file and the problem.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::{Deserialize, Deserializer};
+
+/// Everything that can go wrong reading scene input (scene file, mesh, textures).
+/// Each message is a single line that starts with the offending file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be opened or read.
+    #[error("{}: cannot read file: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// TOML syntax or a field of the wrong name or type (line and column are 1-based).
+    #[error("{}: line {line}, column {column}: {message}", path.display())]
+    Toml {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// A scene value out of its valid range; the message names the key.
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    /// A mesh file that cannot be used.
+    #[error("{}: {message}", path.display())]
+    Mesh { path: PathBuf, message: String },
+    /// A texture file that cannot be used.
+    #[error("{}: {message}", path.display())]
+    Texture { path: PathBuf, message: String },
+}
+
+impl SceneError {
+    pub(crate) fn invalid(path: &Path, message: impl AsRef<str>) -> SceneError {
+        SceneError::Invalid {
+            path: path.to_path_buf(),
+            message: one_line(message.as_ref()),
+        }
+    }
+
+    pub(crate) fn mesh(path: &Path, message: impl AsRef<str>) -> SceneError {
+        SceneError::Mesh {
+            path: path.to_path_buf(),
+            message: one_line(message.as_ref()),
+        }
+    }
+
+    pub(crate) fn texture(path: &Path, message: impl AsRef<str>) -> SceneError {
+        SceneError::Texture {
+            path: path.to_path_buf(),
+            message: one_line(message.as_ref()),
+        }
+    }
+}
+
+/// Collapses any run of whitespace (including newlines) to one space.
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+// ---------------------------------------------------------------------------
+// The scene description. Field defaults are documented in docs/scene-format.md.
+
+/// A parsed scene. `SceneFile::default()` is the built-in head under the `sky`
+/// environment with every other setting at its default.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SceneFile {
+    /// glTF mesh (.glb or .gltf); `None` = the built-in head.
+    pub mesh: Option<PathBuf>,
+    /// Millimetres per mesh unit; `None` = glTF's metres (1000).
+    pub mm_per_unit: Option<f32>,
+    pub textures: Textures,
+    pub environment: Environment,
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub skin: Skin,
+    pub render: Render,
+}
+
+/// Texture maps; each `None` means a constant stand-in (see the docs).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Textures {
+    /// Diffuse albedo, sRGB.
+    pub albedo: Option<PathBuf>,
+    /// Tangent-space normal map, linear (glTF convention: +Y toward image top).
+    pub normal: Option<PathBuf>,
+    /// Specular intensity, linear grey; scales the region's ρs.
+    pub specular: Option<PathBuf>,
+    /// Beckmann roughness m, linear grey (value / 255); replaces the region's m.
+    pub roughness: Option<PathBuf>,
+    /// Face-region ids: red channel = index into `skin.regions` (0..=9).
+    pub regions: Option<PathBuf>,
+}
+
+/// Distant lighting.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Environment {
+    /// `sky`, `sky:elevation=..,azimuth=..,turbidity=..`, `uniform:R,G,B`, or a
+    /// file path (resolved against the scene file's directory on load).
+    pub source: String,
+    /// Rotation about +Y, degrees.
+    pub rotation_deg: f32,
+    /// Radiance multiplier.
+    pub intensity: f32,
+}
+
+impl Default for Environment {
+    fn default() -> Environment {
+        Environment {
+            source: "sky".into(),
+            rotation_deg: 0.0,
+            intensity: 1.0,
+        }
+    }
+}
+
+impl Environment {
+    /// True when `source` names a file rather than a built-in (`sky...`, `uniform:...`).
+    pub fn source_is_path(&self) -> bool {
+        let s = self.source.as_str();
+        !(s == "sky" || s.starts_with("sky:") || s.starts_with("uniform:"))
+    }
+}
+
+/// Camera: `position`/`target`/`up` (world mm) or an `orbit` around the mesh centre.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Camera {
+    pub position: Option<[f32; 3]>,
+    /// Point looked at; `None` = the mesh's bounding-box centre.
+    pub target: Option<[f32; 3]>,
+    /// `None` = +Y.
+    pub up: Option<[f32; 3]>,
+    pub orbit: Option<Orbit>,
+    /// Vertical field of view, degrees.
+    pub fov_deg: f32,
+    pub near_mm: f32,
+    pub far_mm: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Camera {
+        Camera {
+            position: None,
+            target: None,
+            up: None,
+            orbit: None,
+            fov_deg: 30.0,
+            near_mm: 10.0,
+            far_mm: 10_000.0,
+        }
+    }
+}
+
+/// A camera on a sphere around the mesh's bounding-box centre, looking at it.
+/// yaw 0, pitch 0 puts the camera on +Z (the glTF front), +Y up.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Orbit {
+    /// Rotation about +Y, degrees, counter-clockwise seen from above (+X side at 90).
+    pub yaw_deg: f32,
+    /// Elevation above the horizontal plane, degrees, in (-90, 90).
+    pub pitch_deg: f32,
+    /// Distance from the centre, mm.
+    pub distance_mm: f32,
+}
+
+impl Default for Orbit {
+    fn default() -> Orbit {
+        Orbit {
+            yaw_deg: 0.0,
+            pitch_deg: 0.0,
+            distance_mm: 700.0,
+        }
+    }
+}
+
+impl Camera {
+    /// Eye, target and up vector (world mm) given the mesh's bounding-box centre.
+    pub fn eye_target_up(&self, mesh_centre: Vec3) -> (Vec3, Vec3, Vec3) {
+        let up = self.up.map(Vec3::from).unwrap_or(Vec3::Y);
+        match self.position {
+            Some(p) => (
+                Vec3::from(p),
+                self.target.map(Vec3::from).unwrap_or(mesh_centre),
+                up,
+            ),
+            None => {
+                let o = self.orbit.unwrap_or_default();
+                let (yaw, pitch) = (o.yaw_deg.to_radians(), o.pitch_deg.to_radians());
+                let dir = Vec3::new(
+                    pitch.cos() * yaw.sin(),
+                    pitch.sin(),
+                    pitch.cos() * yaw.cos(),
+                );
+                (mesh_centre + o.distance_mm * dir, mesh_centre, up)
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightKind {
+    Directional,
+    Point,
+}
+
+/// An analytic light added to the environment.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    pub kind: LightKind,
+    /// Directional: the direction light travels (from the light into the scene).
+    pub direction: Option<[f32; 3]>,
+    /// Point: world position, mm.
+    pub position: Option<[f32; 3]>,
+    /// Linear RGB.
+    #[serde(default = "white")]
+    pub color: [f32; 3],
+    /// Directional: irradiance on a surface facing the light, in environment
+    /// radiance units × sr. Point: the same at 1000 mm; falls off as 1/d².
+    #[serde(default = "one")]
+    pub intensity: f32,
+    /// Casts shadows through the shadow/depth pass.
+    #[serde(default = "yes")]
+    pub shadow: bool,
+}
+
+fn white() -> [f32; 3] {
+    [1.0, 1.0, 1.0]
+}
+fn one() -> f32 {
+    1.0
+}
+fn yes() -> bool {
+    true
+}
+
+/// Blur kernel for the Gaussian chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kernel {
+    /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in ARCHITECTURE.md).
+    Deon7,
+    /// Wider, exactly normalised Gaussian taps (reference quality).
+    Accurate,
+}
+
+/// How the per-vertex SH transfer's visibility is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Occlusion {
+    /// Cube-map rasterised visibility.
+    Raster,
+    /// Ray-traced visibility.
+    Raytrace,
+    /// No self-occlusion (unshadowed transfer).
+    Off,
+}
+
+/// One term of the sum-of-Gaussians diffusion profile.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileGaussian {
+    /// Variance v in mm², G(v, r) = exp(-r²/2v) / (2πv).
+    pub variance_mm2: f32,
+    /// Linear RGB weight of this term.
+    pub weights: [f32; 3],
+}
+
+/// Kelemen/Szirmay-Kalos specular parameters of one face region.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpecularRegion {
+    pub name: String,
+    /// Specular scale ρs.
+    pub rho_s: f32,
+    /// Beckmann roughness m.
+    pub m: f32,
+}
+
+/// Number of face regions the region map indexes (Weyrich et al. 2006, used by
+/// GPU Gems 3 §14.3).
+pub const REGION_COUNT: usize = 10;
+
+/// Skin appearance parameters.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Skin {
+    /// Albedo applied before scattering as albedo^mix, after as albedo^(1-mix)
+    /// (pre-/post-scatter texturing, GPU Gems 3 §14.5).
+    pub mix: f32,
+    pub kernel: Kernel,
+    /// Sum-of-Gaussians profile, variances strictly increasing.
+    pub profile: Vec<ProfileGaussian>,
+    /// Exactly [`REGION_COUNT`] regions.
+    pub regions: Vec<SpecularRegion>,
+    pub occlusion: Occlusion,
+}
+
+impl Default for Skin {
+    fn default() -> Skin {
+        Skin {
+            mix: 0.5,
+            kernel: Kernel::Deon7,
+            profile: default_profile(),
+            regions: default_regions(),
+            occlusion: Occlusion::Raster,
+        }
+    }
+}
+
+/// The six-Gaussian skin profile of d'Eon & Luebke (GPU Gems 3 ch. 14, §14.4 sum-of-
+/// Gaussians fit, as carried in ARCHITECTURE.md): variance mm², RGB weights; each
+/// channel sums to 1.
+pub fn default_profile() -> Vec<ProfileGaussian> {
+    const TABLE: [(f32, [f32; 3]); 6] = [
+        (0.0064, [0.233, 0.455, 0.649]),
+        (0.0484, [0.100, 0.336, 0.344]),
+        (0.187, [0.118, 0.198, 0.0]),
+        (0.567, [0.113, 0.007, 0.007]),
+        (1.99, [0.358, 0.004, 0.0]),
+        (7.41, [0.078, 0.0, 0.0]),
+    ];
+    TABLE
+        .iter()
+        .map(|&(variance_mm2, weights)| ProfileGaussian {
+            variance_mm2,
+            weights,
+        })
+        .collect()
+}
+
+/// Ten regions at d'Eon & Luebke's fallback values m = 0.3, ρs = 0.18
+/// (GPU Gems 3 §14.3, used where no measured region data exists).
+pub fn default_regions() -> Vec<SpecularRegion> {
+    (0..REGION_COUNT)
+        .map(|i| SpecularRegion {
+            name: format!("region{i}"),
+            rho_s: 0.18,
+            m: 0.3,
+        })
+        .collect()
+}
+
+/// Output transfer function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gamma {
+    /// The piecewise sRGB curve (IEC 61966-2-1).
+    Srgb,
+    /// A pure power: encoded = linear^(1/γ). `"linear"` in the file is 1.0.
+    Power(f32),
+}
+
+impl<'de> Deserialize<'de> for Gamma {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Gamma, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Gamma;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("\"srgb\", \"linear\" or a number (a power-law gamma)")
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<Gamma, E> {
+                match s {
+                    "srgb" => Ok(Gamma::Srgb),
+                    "linear" => Ok(Gamma::Power(1.0)),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(s), &self)),
+                }
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Gamma, E> {
+                Ok(Gamma::Power(v as f32))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Gamma, E> {
+                Ok(Gamma::Power(v as f32))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Gamma, E> {
+                Ok(Gamma::Power(v as f32))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Output image and internal resolution.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Render {
+    pub width: u32,
+    pub height: u32,
+    /// Side of the UV-space irradiance and blur targets (power of two, 256..=8192).
+    pub irradiance_resolution: u32,
+    /// Exposure in EV (stops): output = radiance × 2^exposure. `None`: metered
+    /// from the environment (see `Scene::exposure`).
+    pub exposure: Option<f32>,
+    pub gamma: Gamma,
+}
+
+impl Default for Render {
+    fn default() -> Render {
+        Render {
+            width: 1280,
+            height: 720,
+            irradiance_resolution: 4096,
+            exposure: None,
+            gamma: Gamma::Srgb,
+        }
+    }
+}
+
+/// Largest accepted render width or height.
+pub const MAX_RENDER_SIZE: u32 = 16384;
+
+// ---------------------------------------------------------------------------
+// Loading
+
+/// Reads, parses, validates a scene file and resolves its relative paths against
+/// the file's directory.
+pub fn load_scene(path: &Path) -> Result<SceneFile, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(&text, path)
+}
+
+/// Parses and validates scene text as if it were the file `path` (used in messages
+/// and as the base for relative paths; the file itself is not read).
+pub fn parse_scene(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let mut scene: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+    scene
+        .validate()
+        .map_err(|message| SceneError::invalid(path, message))?;
+    let base = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    scene.resolve_paths(&base);
+    Ok(scene)
+}
+
+/// The toml crate's message with 1-based line and column from its byte span.
+fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> SceneError {
+    let Some(span) = e.span() else {
+        return SceneError::invalid(path, e.message());
+    };
+    let before = text.get(..span.start).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before.get(line_start..).map_or(0, |s| s.chars().count()) + 1;
+    SceneError::Toml {
+        path: path.to_path_buf(),
+        line,
+        column,
+        message: one_line(e.message()),
+    }
+}
+
+impl SceneFile {
+    /// Joins every relative path onto `base` (absolute paths are kept).
+    pub fn resolve_paths(&mut self, base: &Path) {
+        let fix = |p: &mut Option<PathBuf>| {
+            if let Some(path) = p {
+                *path = base.join(&*path);
+            }
+        };
+        fix(&mut self.mesh);
+        fix(&mut self.textures.albedo);
+        fix(&mut self.textures.normal);
+        fix(&mut self.textures.specular);
+        fix(&mut self.textures.roughness);
+        fix(&mut self.textures.regions);
+        if self.environment.source_is_path() {
+            self.environment.source = base
+                .join(&self.environment.source)
+                .to_string_lossy()
+                .into_owned();
+        }
+    }
+
+    /// Checks every value; the error names the key, e.g. `render.width = 0: ...`.
+    pub fn validate(&self) -> Result<(), String> {
+        if let Some(mm) = self.mm_per_unit {
+            positive("mm_per_unit", mm)?;
+        }
+        self.environment.validate()?;
+        self.camera.validate()?;
+        for (i, light) in self.lights.iter().enumerate() {
+            light.validate(&format!("lights[{i}]"))?;
+        }
+        self.skin.validate()?;
+        self.render.validate()
+    }
+}
+
+fn finite(key: &str, v: f32) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{key} = {v}: must be a finite number"))
+    }
+}
+
+fn positive(key: &str, v: f32) -> Result<(), String> {
+    finite(key, v)?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{key} = {v}: must be greater than 0"))
+    }
+}
+
+fn non_negative(key: &str, v: f32) -> Result<(), String> {
+    finite(key, v)?;
+    if v >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{key} = {v}: must not be negative"))
+    }
+}
+
+fn in_range(key: &str, v: f32, lo: f32, hi: f32) -> Result<(), String> {
+    finite(key, v)?;
+    if (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!("{key} = {v}: must be in [{lo}, {hi}]"))
+    }
+}
+
+fn finite3(key: &str, v: [f32; 3]) -> Result<Vec3, String> {
+    let v = Vec3::from(v);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{key} = {v}: every component must be a finite number"
+        ))
+    }
+}
+
+fn nonzero3(key: &str, v: [f32; 3]) -> Result<Vec3, String> {
+    let v = finite3(key, v)?;
+    if v.length_squared() > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{key} = [0, 0, 0]: must not be the zero vector"))
+    }
+}
+
+impl Environment {
+    fn validate(&self) -> Result<(), String> {
+        if self.source.trim().is_empty() {
+            return Err(
+                "environment.source is empty: use \"sky\", \"uniform:R,G,B\" or a file path".into(),
+            );
+        }
+        finite("environment.rotation_deg", self.rotation_deg)?;
+        non_negative("environment.intensity", self.intensity)
+    }
+}
+
+impl Camera {
+    fn validate(&self) -> Result<(), String> {
+        let fov = self.fov_deg;
+        finite("camera.fov_deg", fov)?;
+        if !(fov > 1.0 && fov < 179.0) {
+            return Err(format!(
+                "camera.fov_deg = {fov}: must be in (1, 179) degrees"
+            ));
+        }
+        positive("camera.near_mm", self.near_mm)?;
+        positive("camera.far_mm", self.far_mm)?;
+        if self.far_mm <= self.near_mm {
+            return Err(format!(
+                "camera.far_mm = {} must be greater than camera.near_mm = {}",
+                self.far_mm, self.near_mm
+            ));
+        }
+        match (self.position, &self.orbit) {
+            (Some(_), Some(_)) => {
+                return Err(
+                    "camera: give either position (with target, up) or orbit, not both".into(),
+                )
+            }
+            (None, _) if self.target.is_some() || self.up.is_some() => {
+                return Err("camera.target and camera.up need camera.position".into())
+            }
+            _ => {}
+        }
+        if let Some(p) = self.position {
+            let p = finite3("camera.position", p)?;
+            let up = match self.up {
+                Some(u) => nonzero3("camera.up", u)?,
+                None => Vec3::Y,
+            };
+            if let Some(t) = self.target {
+                let view = finite3("camera.target", t)? - p;
+                if view.length_squared() == 0.0 {
+                    return Err("camera.target equals camera.position".into());
+                }
+                if view.normalize().cross(up.normalize()).length() < 1e-3 {
+                    return Err("camera.up is parallel to the viewing direction".into());
+                }
+            }
+        }
+        if let Some(o) = &self.orbit {
+            finite("camera.orbit.yaw_deg", o.yaw_deg)?;
+            finite("camera.orbit.pitch_deg", o.pitch_deg)?;
+            if !(o.pitch_deg > -90.0 && o.pitch_deg < 90.0) {
+                return Err(format!(
+                    "camera.orbit.pitch_deg = {}: must be in (-90, 90) degrees",
+                    o.pitch_deg
+                ));
+            }
+            positive("camera.orbit.distance_mm", o.distance_mm)?;
+        }
+        Ok(())
+    }
+}
+
+impl Light {
+    fn validate(&self, key: &str) -> Result<(), String> {
+        match self.kind {
+            LightKind::Directional => {
+                if self.position.is_some() {
+                    return Err(format!(
+                        "{key}.position: a directional light has a direction, not a position"
+                    ));
+                }
+                let d = self.direction.ok_or_else(|| {
+                    format!("{key}.direction is required for a directional light")
+                })?;
+                nonzero3(&format!("{key}.direction"), d)?;
+            }
+            LightKind::Point => {
+                if self.direction.is_some() {
+                    return Err(format!(
+                        "{key}.direction: a point light has a position, not a direction"
+                    ));
+                }
+                let p = self
+                    .position
+                    .ok_or_else(|| format!("{key}.position is required for a point light"))?;
+                finite3(&format!("{key}.position"), p)?;
+            }
+        }
+        for (c, v) in ["r", "g", "b"].iter().zip(self.color) {
+            non_negative(&format!("{key}.color.{c}"), v)?;
+        }
+        non_negative(&format!("{key}.intensity"), self.intensity)
+    }
+}
+
+/// Allowed deviation of each channel's profile weight sum from 1.
+pub const PROFILE_SUM_TOLERANCE: f32 = 0.01;
+
+impl Skin {
+    fn validate(&self) -> Result<(), String> {
+        in_range("skin.mix", self.mix, 0.0, 1.0)?;
+        if self.profile.is_empty() {
+            return Err("skin.profile is empty: give at least one Gaussian".into());
+        }
+        let mut sums = [0.0f32; 3];
+        let mut previous: Option<f32> = None;
+        for (i, g) in self.profile.iter().enumerate() {
+            let key = format!("skin.profile[{i}]");
+            non_negative(&format!("{key}.variance_mm2"), g.variance_mm2)?;
+            if let Some(prev) = previous {
+                if g.variance_mm2 <= prev {
+                    return Err(format!(
+                        "{key}.variance_mm2 = {}: variances must increase strictly (the blur chain \
+                         blurs each level from the previous one by the difference)",
+                        g.variance_mm2
+                    ));
+                }
+            }
+            previous = Some(g.variance_mm2);
+            for (c, (sum, w)) in sums.iter_mut().zip(g.weights).enumerate() {
+                non_negative(&format!("{key}.weights[{c}]"), w)?;
+                *sum += w;
+            }
+        }
+        for (c, sum) in ["red", "green", "blue"].iter().zip(sums) {
+            if (sum - 1.0).abs() > PROFILE_SUM_TOLERANCE {
+                return Err(format!(
+                    "skin.profile: the {c} weights sum to {sum}, not 1 (±{PROFILE_SUM_TOLERANCE})"
+                ));
+            }
+        }
+        if self.regions.len() != REGION_COUNT {
+            return Err(format!(
+                "skin.regions has {} entries; it needs exactly {REGION_COUNT}",
+                self.regions.len()
+            ));
+        }
+        for (i, r) in self.regions.iter().enumerate() {
+            in_range(&format!("skin.regions[{i}].rho_s"), r.rho_s, 0.0, 1.0)?;
+            positive(&format!("skin.regions[{i}].m"), r.m)?;
+            in_range(&format!("skin.regions[{i}].m"), r.m, 0.0, 1.0)?;
+        }
+        Ok(())
+    }
+}
+
+impl Render {
+    fn validate(&self) -> Result<(), String> {
+        for (key, v) in [("render.width", self.width), ("render.height", self.height)] {
+            if v == 0 || v > MAX_RENDER_SIZE {
+                return Err(format!("{key} = {v}: must be in 1..={MAX_RENDER_SIZE}"));
+            }
+        }
+        let r = self.irradiance_resolution;
+        if !r.is_power_of_two() || !(256..=8192).contains(&r) {
+            return Err(format!(
+                "render.irradiance_resolution = {r}: must be a power of two in 256..=8192"
+            ));
+        }
+        if let Some(e) = self.exposure {
+            finite("render.exposure", e)?;
+        }
+        if let Gamma::Power(g) = self.gamma {
+            finite("render.gamma", g)?;
+            if !(g > 0.0 && g <= 10.0) {
+                return Err(format!("render.gamma = {g}: must be in (0, 10]"));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<SceneFile, SceneError> {
+        parse_scene(text, Path::new("/scenes/scene.toml"))
+    }
+
+    fn err(text: &str) -> String {
+        match parse(text) {
+            Ok(s) => panic!("accepted: {text}\n{s:?}"),
+            Err(e) => {
+                let msg = e.to_string();
+                assert!(msg.starts_with("/scenes/scene.toml: "), "{msg}");
+                assert!(!msg.contains('\n'), "{msg}");
+                msg
+            }
+        }
+    }
+
+    /// The repository root: this file lives at `src/scene/file.rs`.
+    fn repo_root() -> PathBuf {
+        let here = Path::new(file!());
+        let file = if here.is_absolute() {
+            here.to_path_buf()
+        } else {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(here)
+        };
+        file.ancestors().nth(3).map(Path::to_path_buf).unwrap()
+    }
+
+    fn assets() -> Option<PathBuf> {
+        let dir = std::env::var_os("DERMIS_ASSETS")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| {
+                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
+            });
+        if dir.is_dir() {
+            Some(dir)
+        } else {
+            println!("skipping: test assets not found at {}", dir.display());
+            None
+        }
+    }
+
+    /// The ```toml blocks of docs/scene-format.md.
+    fn doc_examples() -> Vec<String> {
+        let doc = repo_root().join("docs/scene-format.md");
+        let text = std::fs::read_to_string(&doc).unwrap();
+        let mut blocks = Vec::new();
+        let mut current: Option<String> = None;
+        for line in text.lines() {
+            match (&mut current, line.trim_start()) {
+                (None, l) if l.starts_with("```toml") => current = Some(String::new()),
+                (Some(_), l) if l.starts_with("```") => blocks.extend(current.take()),
+                (Some(block), _) => {
+                    block.push_str(line);
+                    block.push('\n');
+                }
+                _ => {}
+            }
+        }
+        blocks
+    }
+
+    #[test]
+    fn empty_file_is_the_default_scene() {
+        let scene = parse("").unwrap();
+        assert_eq!(scene, SceneFile::default());
+        assert!(SceneFile::default().validate().is_ok());
+        assert_eq!(scene.mesh, None);
+        assert_eq!(scene.environment.source, "sky");
+        assert_eq!(scene.skin.mix, 0.5);
+        assert_eq!(scene.skin.profile.len(), 6);
+        assert_eq!(scene.skin.regions.len(), 10);
+        assert!(scene
+            .skin
+            .regions
+            .iter()
+            .all(|r| r.m == 0.3 && r.rho_s == 0.18));
+        assert_eq!(scene.render.irradiance_resolution, 4096);
+        assert_eq!(scene.render.gamma, Gamma::Srgb);
+    }
+
+    #[test]
+    fn default_profile_is_normalised_per_channel() {
+        // Independent check of the published table: each channel sums to 1.
+        let p = default_profile();
+        for c in 0..3 {
+            let sum: f32 = p.iter().map(|g| g.weights[c]).sum();
+            assert!((sum - 1.0).abs() < 1e-3, "channel {c}: {sum}");
+        }
+        let v: Vec<f32> = p.iter().map(|g| g.variance_mm2).collect();
+        assert_eq!(v, [0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41]);
+    }
+
+    #[test]
+    fn full_file_parses_and_resolves_paths() {
+        let text = r#"
+mesh = "meshes/head.glb"
+mm_per_unit = 50.3
+
+[textures]
+albedo = "maps/albedo.jpg"
+normal = "/abs/normal.png"
+
+[environment]
+source = "env/studio.exr"
+rotation_deg = 90
+intensity = 2.5
+
+[camera]
+orbit = { yaw_deg = 30, pitch_deg = 10, distance_mm = 600 }
+fov_deg = 25
+
+[[lights]]
+kind = "directional"
+direction = [0, -1, -1]
+color = [1, 0.9, 0.8]
+intensity = 3
+
+[[lights]]
+kind = "point"
+position = [0, 500, 500]
+shadow = false
+
+[skin]
+mix = 0.25
+kernel = "accurate"
+occlusion = "off"
+profile = [
+  { variance_mm2 = 0.01, weights = [0.5, 0.5, 0.5] },
+  { variance_mm2 = 1.0, weights = [0.5, 0.5, 0.5] },
+]
+
+[render]
+width = 640
+height = 480
+irradiance_resolution = 1024
+exposure = -1.5
+gamma = 2.2
+"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.mesh, Some(PathBuf::from("/scenes/meshes/head.glb")));
+        assert_eq!(s.mm_per_unit, Some(50.3));
+        assert_eq!(
+            s.textures.albedo,
+            Some(PathBuf::from("/scenes/maps/albedo.jpg"))
+        );
+        assert_eq!(s.textures.normal, Some(PathBuf::from("/abs/normal.png")));
+        assert_eq!(s.textures.specular, None);
+        assert_eq!(s.environment.source, "/scenes/env/studio.exr");
+        assert_eq!(s.environment.intensity, 2.5);
+        assert_eq!(s.camera.fov_deg, 25.0);
+        assert_eq!(s.lights.len(), 2);
+        assert_eq!(s.lights[0].kind, LightKind::Directional);
+        assert!(s.lights[0].shadow);
+        assert_eq!(s.lights[1].color, [1.0, 1.0, 1.0]);
+        assert!(!s.lights[1].shadow);
+        assert_eq!(s.skin.kernel, Kernel::Accurate);
+        assert_eq!(s.skin.occlusion, Occlusion::Off);
+        assert_eq!(s.skin.profile.len(), 2);
+        assert_eq!(s.render.gamma, Gamma::Power(2.2));
+        assert_eq!(s.render.exposure, Some(-1.5));
+
+        // Orbit: yaw 30, pitch 10, 600 mm from the centre.
+        let centre = Vec3::new(1.0, 2.0, 3.0);
+        let (eye, target, up) = s.camera.eye_target_up(centre);
+        assert_eq!(target, centre);
+        assert_eq!(up, Vec3::Y);
+        assert!(((eye - centre).length() - 600.0).abs() < 1e-3);
+        let d = (eye - centre) / 600.0;
+        assert!((d.y - 10f32.to_radians().sin()).abs() < 1e-6);
+        assert!((d.x / d.z - 30f32.to_radians().tan()).abs() < 1e-5);
+    }
+
+    #[test]
+    fn environment_keywords_are_not_paths() {
+        for src in [
+            "sky",
+            "sky:elevation=30,azimuth=10,turbidity=3",
+            "uniform:1,1,1",
+        ] {
+            let s = parse(&format!("[environment]\nsource = \"{src}\"")).unwrap();
+            assert_eq!(s.environment.source, src);
+        }
+        let s = parse("[environment]\nsource = \"skylight.hdr\"").unwrap();
+        assert_eq!(s.environment.source, "/scenes/skylight.hdr");
+        let s = parse_scene("mesh = \"a.glb\"", Path::new("scene.toml")).unwrap();
+        assert_eq!(s.mesh, Some(PathBuf::from("./a.glb")));
+    }
+
+    #[test]
+    fn camera_look_at() {
+        let s = parse("[camera]\nposition = [0, 0, 500]\n").unwrap();
+        let (eye, target, up) = s.camera.eye_target_up(Vec3::new(0.0, 10.0, 0.0));
+        assert_eq!(eye, Vec3::new(0.0, 0.0, 500.0));
+        assert_eq!(target, Vec3::new(0.0, 10.0, 0.0));
+        assert_eq!(up, Vec3::Y);
+        // Default camera: orbit yaw 0 pitch 0 puts the eye on +Z at 700 mm.
+        let (eye, _, _) = Camera::default().eye_target_up(Vec3::ZERO);
+        assert!((eye - Vec3::new(0.0, 0.0, 700.0)).length() < 1e-3);
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let msg = err("[render]\nwidth = 10\n\n[camera]\nfov = 30\n");
+        assert!(msg.contains("line 5, column 1"), "{msg}");
+        assert!(msg.contains("unknown field `fov`"), "{msg}");
+        let msg = err("meshes = \"a.glb\"");
+        assert!(msg.contains("line 1") && msg.contains("`meshes`"), "{msg}");
+        let msg = err("[skin]\nprofile = [{ variance_mm2 = 1, weights = [1,1,1], extra = 2 }]");
+        assert!(msg.contains("line 2") && msg.contains("`extra`"), "{msg}");
+        let msg = err("[[lights]]\nkind = \"point\"\nposition = [0,0,0]\ncolour = [1,1,1]");
+        assert!(msg.contains("line 4") && msg.contains("`colour`"), "{msg}");
+    }
+
+    #[test]
+    fn syntax_and_type_errors_have_positions() {
+        for (text, line, needle) in [
+            ("[render\nwidth = 3", 1, ""),
+            ("[render]\nwidth = ", 2, ""),
+            ("mesh = \"unterminated", 1, ""),
+            ("[render]\nwidth = \"wide\"", 2, "invalid type"),
+            ("[render]\nwidth = -5", 2, ""),
+            ("[render]\nwidth = 1.5", 2, "invalid type"),
+            ("[skin]\nmix = \"half\"", 2, "invalid type"),
+            ("[skin]\nkernel = \"box\"", 2, "unknown variant"),
+            ("[[lights]]\nkind = \"spot\"", 2, "unknown variant"),
+            ("[[lights]]\ndirection = [0,0,1]", 1, "missing field `kind`"),
+            ("[render]\ngamma = \"s-rgb\"", 2, "srgb"),
+            ("[camera]\nposition = [1, 2]", 2, ""),
+            ("lights = 3", 1, "invalid type"),
+        ] {
+            let msg = err(text);
+            assert!(msg.contains(&format!("line {line},")), "{text:?}: {msg}");
+            assert!(msg.contains(needle), "{text:?}: {msg}");
+        }
+    }
+
+    #[test]
+    fn out_of_range_values_are_rejected_with_their_key() {
+        for (text, needle) in [
+            (
+                "[render]\nirradiance_resolution = 3000",
+                "render.irradiance_resolution = 3000",
+            ),
+            (
+                "[render]\nirradiance_resolution = 128",
+                "render.irradiance_resolution = 128",
+            ),
+            (
+                "[render]\nirradiance_resolution = 16384",
+                "render.irradiance_resolution",
+            ),
+            ("[render]\nwidth = 0", "render.width = 0"),
+            ("[render]\nheight = 16385", "render.height = 16385"),
+            ("[render]\nexposure = nan", "render.exposure"),
+            ("[render]\ngamma = 0", "render.gamma"),
+            ("[skin]\nmix = 1.5", "skin.mix = 1.5"),
+            ("[skin]\nmix = -0.1", "skin.mix"),
+            ("[skin]\nmix = nan", "skin.mix = NaN"),
+            (
+                "[skin]\nprofile = [{ variance_mm2 = 1, weights = [0.5, 1, 1] }]",
+                "red weights sum to 0.5",
+            ),
+            (
+                "[skin]\nprofile = [{ variance_mm2 = -1, weights = [1, 1, 1] }]",
+                "skin.profile[0].variance_mm2 = -1",
+            ),
+            (
+                "[skin]\nprofile = [{ variance_mm2 = 2, weights = [0.5, 0.5, 0.5] }, \
+                 { variance_mm2 = 1, weights = [0.5, 0.5, 0.5] }]",
+                "increase strictly",
+            ),
+            ("[skin]\nprofile = []", "skin.profile is empty"),
+            (
+                "[skin]\nregions = [{ name = \"a\", rho_s = 0.2, m = 0.3 }]",
+                "exactly 10",
+            ),
+            ("[camera]\nfov_deg = 1", "camera.fov_deg = 1"),
+            ("[camera]\nfov_deg = 179", "camera.fov_deg = 179"),
+            ("[camera]\nfov_deg = inf", "camera.fov_deg"),
+            ("[camera]\nnear_mm = 100\nfar_mm = 50", "camera.far_mm"),
+            ("[camera]\nposition = [0, nan, 0]", "camera.position"),
+            (
+                "[camera]\nposition = [0, 0, 1]\ntarget = [0, 0, 1]",
+                "camera.target",
+            ),
+            (
+                "[camera]\nposition = [0, 0, 1]\nup = [0, 0, 1]\ntarget = [0, 0, 0]",
+                "parallel",
+            ),
+            (
+                "[camera]\norbit = { pitch_deg = 90 }",
+                "camera.orbit.pitch_deg",
+            ),
+            (
+                "[camera]\norbit = { distance_mm = 0 }",
+                "camera.orbit.distance_mm",
+            ),
+            ("[camera]\norbit = {}\nposition = [1, 1, 1]", "not both"),
+            ("[camera]\ntarget = [1, 1, 1]", "need camera.position"),
+            (
+                "[[lights]]\nkind = \"directional\"",
+                "lights[0].direction is required",
+            ),
+            (
+                "[[lights]]\nkind = \"directional\"\ndirection = [0, 0, 0]",
+                "lights[0].direction",
+            ),
+            (
+                "[[lights]]\nkind = \"point\"\ndirection = [0, 0, 1]",
+                "lights[0].direction",
+            ),
+            (
+                "[[lights]]\nkind = \"point\"\nposition = [0, 0, 1]\nintensity = -1",
+                "lights[0].intensity",
+            ),
+            (
+                "[[lights]]\nkind = \"point\"\nposition = [0, 0, 1]\ncolor = [1, nan, 1]",
+                "lights[0].color.g",
+            ),
+            ("mm_per_unit = 0", "mm_per_unit = 0"),
+            ("mm_per_unit = -inf", "mm_per_unit"),
+            ("[environment]\nintensity = -1", "environment.intensity"),
+            (
+                "[environment]\nrotation_deg = nan",
+                "environment.rotation_deg",
+            ),
+            ("[environment]\nsource = \"\"", "environment.source"),
+        ] {
+            let msg = err(text);
+            assert!(msg.contains(needle), "{text:?}: {msg}");
+        }
+        // Ten custom regions are fine; one bad m is not.
+        let mut regions = String::from("[skin]\nregions = [\n");
+        for i in 0..10 {
+            let m = if i == 7 { 0.0 } else { 0.35 };
+            regions.push_str(&format!("{{ name = \"r{i}\", rho_s = 0.15, m = {m} }},\n"));
+        }
+        regions.push(']');
+        assert!(err(&regions).contains("skin.regions[7].m"));
+        let fixed = parse(&regions.replace("m = 0 }", "m = 0.2 }")).unwrap();
+        assert_eq!(fixed.skin.regions[7].m, 0.2);
+        assert_eq!(fixed.skin.regions[9].name, "r9");
+    }
+
+    #[test]
+    fn missing_file_is_an_io_error() {
+        let path = std::env::temp_dir().join("dermis-no-such-dir/none.toml");
+        let msg = load_scene(&path).unwrap_err().to_string();
+        assert!(
+            msg.contains("none.toml") && msg.contains("cannot read"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn truncated_files_fail_cleanly() {
+        let text = doc_examples().into_iter().last().unwrap();
+        let mut rejected = 0;
+        for cut in 1..text.len() {
+            let Some(prefix) = text.get(..cut) else {
+                continue;
+            };
+            if let Err(e) = parse(prefix) {
+                assert!(!e.to_string().contains('\n'));
+                rejected += 1;
+            }
+        }
+        // Many prefixes end mid-token; they must all be reported, not panic.
+        assert!(rejected > text.len() / 4, "{rejected} of {}", text.len());
+    }
+
+    #[test]
+    fn doc_examples_parse_and_validate() {
+        let examples = doc_examples();
+        assert!(
+            examples.len() >= 2,
+            "docs/scene-format.md has no ```toml examples"
+        );
+        for (i, text) in examples.iter().enumerate() {
+            if let Err(e) = parse(text) {
+                panic!("docs example {i} fails: {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn lee_perry_smith_example_loads_end_to_end() {
+        let Some(assets) = assets() else { return };
+        if !assets.join("head/lee-perry-smith").is_dir() {
+            println!("skipping: no Lee Perry-Smith head in {}", assets.display());
+            return;
+        }
+        let text = doc_examples().into_iter().last().unwrap();
+        // The example lives in the repository root, next to `../shared`.
+        let text = text.replace("../shared/assets", &assets.to_string_lossy());
+        let scene = parse_scene(&text, &repo_root().join("head.toml")).unwrap();
+        assert_eq!(scene.mm_per_unit, Some(50.3));
+        let mesh_path = scene.mesh.as_deref().unwrap();
+        let mesh = super::super::gltf::load_mesh(mesh_path, scene.mm_per_unit).unwrap();
+        assert_eq!(mesh.triangle_count(), 17_684);
+        use super::super::texture::{load_texture, Encoding};
+        for (p, enc) in [
+            (&scene.textures.albedo, Encoding::Srgb),
+            (&scene.textures.normal, Encoding::Linear),
+            (&scene.textures.specular, Encoding::Linear),
+        ] {
+            let t = load_texture(p.as_deref().unwrap(), enc).unwrap();
+            assert_eq!((t.width, t.height), (1024, 1024));
+        }
+    }
+
+    #[test]
+    fn fuzzed_scene_text_never_panics() {
+        let text = doc_examples().into_iter().last().unwrap();
+        let bytes = text.as_bytes();
+        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            // xorshift64* (Vigna 2016)
+            rng ^= rng >> 12;
+            rng ^= rng << 25;
+            rng ^= rng >> 27;
+            rng.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        };
+        let (mut ok, mut rejected) = (0, 0);
+        for i in 0..400 {
+            let mut b = bytes.to_vec();
+            if i % 2 == 0 {
+                b.truncate((next() as usize) % bytes.len());
+            } else {
+                for _ in 0..1 + next() % 4 {
+                    let at = (next() as usize) % b.len();
+                    b[at] ^= 1 << (next() % 8);
+                }
+            }
+            let outcome = std::panic::catch_unwind(|| match String::from_utf8(b) {
+                Ok(s) => parse(&s).map(|_| ()).map_err(|e| e.to_string()),
+                Err(_) => Err("not UTF-8".to_string()),
+            });
+            match outcome {
+                Ok(Ok(())) => ok += 1,
+                Ok(Err(msg)) => {
+                    assert!(!msg.contains('\n'), "{msg}");
+                    rejected += 1
+                }
+                Err(_) => panic!("scene parser panicked on case {i}"),
+            }
+        }
+        println!("fuzzed scenes: {ok} accepted, {rejected} rejected");
+        assert!(rejected > 0 && ok > 0);
+    }
+}

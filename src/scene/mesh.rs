@@ -1,0 +1,72 @@
+//! Triangle meshes as the renderer consumes them: positions in millimetres.
+
+use glam::{Vec2, Vec3, Vec4};
+
+/// An indexed triangle mesh in physical units.
+///
+/// Positions are in **millimetres** (skin scattering widths are in mm, GPU Gems 3
+/// ch. 14); loaders multiply by the scene's `mm_per_unit`. UVs follow the glTF
+/// convention: origin at the top-left of the texture, v pointing down.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    /// xyz: tangent along +u; w: sign of the bitangent (MikkTSpace convention).
+    pub tangents: Vec<Vec4>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Axis-aligned bounds (min, max) in mm; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let first = *self.positions.first()?;
+        Some(
+            self.positions
+                .iter()
+                .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
+        )
+    }
+
+    /// Checks the invariants every consumer relies on; returns what is wrong.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.positions.len();
+        if n == 0 || self.indices.is_empty() {
+            return Err("mesh has no triangles".into());
+        }
+        if self.normals.len() != n || self.uvs.len() != n || self.tangents.len() != n {
+            return Err(format!(
+                "attribute counts differ: {n} positions, {} normals, {} uvs, {} tangents",
+                self.normals.len(),
+                self.uvs.len(),
+                self.tangents.len()
+            ));
+        }
+        if !self.indices.len().is_multiple_of(3) {
+            return Err(format!(
+                "{} indices is not a multiple of 3",
+                self.indices.len()
+            ));
+        }
+        if let Some(i) = self.indices.iter().find(|&&i| i as usize >= n) {
+            return Err(format!("index {i} out of range for {n} vertices"));
+        }
+        let finite = self.positions.iter().all(|p| p.is_finite())
+            && self.normals.iter().all(|v| v.is_finite())
+            && self.uvs.iter().all(|v| v.is_finite())
+            && self.tangents.iter().all(|v| v.is_finite());
+        if !finite {
+            return Err("mesh has NaN or infinite attributes".into());
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,220 @@
+//! Everything the renderer reads: meshes (glTF or the built-in head), textures,
+//! the environment, camera and lights, from a TOML scene file plus CLI overrides.
+
+pub mod camera;
+pub mod file;
+pub mod gltf;
+pub mod head;
+pub mod mesh;
+pub mod texture;
+
+use crate::error::Result;
+use crate::light::envmap::{self, EnvMap};
+use camera::Camera;
+use file::{LightKind, SceneFile};
+use glam::Vec3;
+use mesh::Mesh;
+use std::path::PathBuf;
+use texture::{Encoding, Texture};
+
+/// Size of procedural environments (`uniform:`, `sky`): 1024×512, the size of the
+/// CC0 maps in shared/assets/env.
+pub const PROCEDURAL_ENV_SIZE: (u32, u32) = (1024, 512);
+
+/// CLI flags that override the scene file's common fields.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub mesh: Option<PathBuf>,
+    pub mm_per_unit: Option<f32>,
+    pub env: Option<String>,
+    pub env_rotate_deg: Option<f32>,
+    pub exposure: Option<f32>,
+    pub irradiance_resolution: Option<u32>,
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+impl Overrides {
+    /// Applies the overrides and re-validates the result.
+    pub fn apply(&self, mut file: SceneFile) -> Result<SceneFile> {
+        if self.mesh.is_some() {
+            file.mesh = self.mesh.clone();
+        }
+        file.mm_per_unit = self.mm_per_unit.or(file.mm_per_unit);
+        if let Some(env) = &self.env {
+            file.environment.source = env.clone();
+        }
+        file.environment.rotation_deg =
+            self.env_rotate_deg.unwrap_or(file.environment.rotation_deg);
+        file.render.exposure = self.exposure.or(file.render.exposure);
+        file.render.irradiance_resolution = self
+            .irradiance_resolution
+            .unwrap_or(file.render.irradiance_resolution);
+        file.render.width = self.width.unwrap_or(file.render.width);
+        file.render.height = self.height.unwrap_or(file.render.height);
+        file.validate()
+            .map_err(|m| crate::Error::Input(format!("command line: {m}")))?;
+        Ok(file)
+    }
+}
+
+/// A light as the shaders use it: direction towards the light and the irradiance
+/// it delivers to a surface facing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    pub direction: Vec3,
+    pub irradiance: Vec3,
+}
+
+/// A scene loaded into memory, in millimetres.
+pub struct Scene {
+    pub mesh: Mesh,
+    pub albedo: Texture,
+    pub normal: Texture,
+    pub specular: Texture,
+    pub regions: Texture,
+    pub env: EnvMap,
+    pub camera: Camera,
+    pub lights: Vec<DirectionalLight>,
+    /// The settings it was loaded from (skin, render, environment rotation and intensity).
+    pub file: SceneFile,
+}
+
+impl Scene {
+    pub fn load(file: SceneFile) -> Result<Scene> {
+        let t = &file.textures;
+        let load = |path: &Option<PathBuf>, encoding, default: [u8; 4]| -> Result<Texture> {
+            Ok(match path {
+                Some(p) => texture::load_texture(p, encoding)?,
+                None => Texture::solid(default, encoding),
+            })
+        };
+        let (mesh, albedo, normal, regions) = match &file.mesh {
+            Some(path) => (
+                gltf::load_mesh(path, file.mm_per_unit)?,
+                load(&t.albedo, Encoding::Srgb, texture::DEFAULT_ALBEDO_SRGB)?,
+                load(&t.normal, Encoding::Linear, texture::FLAT_NORMAL)?,
+                load(&t.regions, Encoding::Linear, texture::DEFAULT_REGION)?,
+            ),
+            None => {
+                let head = head::build_head(&head::HeadParams::default());
+                let size = head.texture_size;
+                let tex = |rgba8, encoding| Texture {
+                    width: size,
+                    height: size,
+                    encoding,
+                    rgba8,
+                };
+                // A scene file may still replace the built-in head's maps.
+                let albedo = match &t.albedo {
+                    Some(_) => load(&t.albedo, Encoding::Srgb, texture::DEFAULT_ALBEDO_SRGB)?,
+                    None => tex(head.albedo_srgb, Encoding::Srgb),
+                };
+                let normal = match &t.normal {
+                    Some(_) => load(&t.normal, Encoding::Linear, texture::FLAT_NORMAL)?,
+                    None => tex(head.normal_detail, Encoding::Linear),
+                };
+                let regions = match &t.regions {
+                    Some(_) => load(&t.regions, Encoding::Linear, texture::DEFAULT_REGION)?,
+                    None => tex(head.regions, Encoding::Linear),
+                };
+                (head.mesh, albedo, normal, regions)
+            }
+        };
+        let specular = load(&t.specular, Encoding::Linear, texture::DEFAULT_SPECULAR)?;
+        let source = envmap::parse_source(&file.environment.source)?;
+        let (w, h) = PROCEDURAL_ENV_SIZE;
+        let (env, report) = envmap::resolve(&source, w, h)?;
+        if report.total() > 0 {
+            log::warn!(
+                "{}: replaced {} NaN, {} infinite and {} negative texel values",
+                file.environment.source,
+                report.nan,
+                report.inf,
+                report.negative
+            );
+        }
+        let bounds = mesh
+            .bounds()
+            .ok_or_else(|| crate::Error::Input("the mesh is empty".into()))?;
+        let camera = camera_for(&file, bounds);
+        let centre = 0.5 * (bounds.0 + bounds.1);
+        let lights = file
+            .lights
+            .iter()
+            .map(|l| {
+                let colour = Vec3::from(l.color) * l.intensity;
+                match l.kind {
+                    LightKind::Directional => DirectionalLight {
+                        direction: -Vec3::from(l.direction.unwrap_or([0.0, -1.0, 0.0]))
+                            .normalize_or_zero(),
+                        irradiance: colour,
+                    },
+                    // Until shadowed point lights land (the specular issue), a point
+                    // light acts as a directional one seen from the mesh centre.
+                    LightKind::Point => {
+                        let p = Vec3::from(l.position.unwrap_or([0.0, 0.0, 1000.0]));
+                        log::warn!(
+                            "point light at {p}: approximated as directional from the mesh centre"
+                        );
+                        DirectionalLight {
+                            direction: (p - centre).normalize_or_zero(),
+                            irradiance: colour,
+                        }
+                    }
+                }
+            })
+            .collect();
+        Ok(Scene {
+            mesh,
+            albedo,
+            normal,
+            specular,
+            regions,
+            env,
+            camera,
+            lights,
+            file,
+        })
+    }
+}
+
+impl Scene {
+    /// Exposure in EV: the scene's, or metered from the environment so that its
+    /// mean radiance (× intensity) maps to 0.6 before the sRGB curve. A
+    /// reflected-light meter's rule, chosen so that the built-in sky (in kcd/m²)
+    /// and the CC0 maps (mean 0.3–1) both render without tuning.
+    pub fn exposure(&self) -> f32 {
+        self.file.render.exposure.unwrap_or_else(|| {
+            let mean = self.env.mean() * self.file.environment.intensity;
+            let luminance = mean.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+            if luminance > 0.0 && luminance.is_finite() {
+                (0.6 / luminance).log2()
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+/// The scene's camera; with neither a position nor an orbit given, it frames the
+/// mesh from the front (yaw 0, pitch 0).
+fn camera_for(file: &SceneFile, bounds: (Vec3, Vec3)) -> Camera {
+    let c = &file.camera;
+    let centre = 0.5 * (bounds.0 + bounds.1);
+    let mut camera = if c.position.is_none() && c.orbit.is_none() {
+        Camera::orbit(bounds, 0.0, 0.0, c.fov_deg, 0.9)
+    } else {
+        let (position, target, up) = c.eye_target_up(centre);
+        Camera {
+            position,
+            target,
+            up,
+            fov_y_deg: c.fov_deg,
+            near_mm: c.near_mm,
+            far_mm: c.far_mm,
+        }
+    };
+    camera.fov_y_deg = c.fov_deg;
+    camera
+}

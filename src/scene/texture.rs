@@ -1,0 +1,415 @@
+//! 8-bit RGBA textures loaded from PNG or JPEG files.
+//!
+//! Every image becomes tightly packed RGBA8 (row-major, top row first): grey is
+//! replicated to RGB, a missing alpha becomes 255, 16-bit channels are rounded to
+//! 8 bits. The [`Encoding`] records how the GPU must interpret the bytes.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use image::{ImageDecoder, ImageFormat, ImageReader, Limits};
+
+use super::file::SceneError;
+
+/// Largest accepted width or height (also the render-size limit of the scene file).
+pub const MAX_TEXTURE_SIZE: u32 = 16384;
+
+/// Stand-ins for maps a scene leaves out (docs/scene-format.md, `[textures]`).
+/// Albedo: sRGB 188 = linear 0.50 (IEC 61966-2-1), a neutral mid grey.
+pub const DEFAULT_ALBEDO_SRGB: [u8; 4] = [188, 188, 188, 255];
+/// Tangent-space (0, 0, 1): `n = 2·rgb/255 − 1`.
+pub const FLAT_NORMAL: [u8; 4] = [128, 128, 255, 255];
+/// Specular scale 1: each region's ρs is used as it is.
+pub const DEFAULT_SPECULAR: [u8; 4] = [255, 255, 255, 255];
+/// Region 0 everywhere.
+pub const DEFAULT_REGION: [u8; 4] = [0, 0, 0, 255];
+
+/// How the stored bytes map to values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Encoding {
+    /// sRGB transfer function (colour maps such as albedo); sample through an `_SRGB` format.
+    Srgb,
+    /// Linear values in 0..=1 (normal, specular, roughness and region maps).
+    Linear,
+}
+
+/// A decoded image, `width * height * 4` bytes of RGBA8.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub encoding: Encoding,
+    pub rgba8: Vec<u8>,
+}
+
+impl Texture {
+    /// A 1 x 1 texture of one colour (the stand-in for a map the scene leaves out).
+    pub fn solid(rgba: [u8; 4], encoding: Encoding) -> Texture {
+        Texture {
+            width: 1,
+            height: 1,
+            encoding,
+            rgba8: rgba.to_vec(),
+        }
+    }
+}
+
+/// Loads a PNG or JPEG file (the format is detected from the content) as RGBA8.
+pub fn load_texture(path: &Path, encoding: Encoding) -> Result<Texture, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode_texture(&bytes, encoding).map_err(|message| SceneError::texture(path, message))
+}
+
+/// Decodes an in-memory PNG or JPEG; the error is a one-line description.
+fn decode_texture(bytes: &[u8], encoding: Encoding) -> Result<Texture, String> {
+    let reader = ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read image: {e}"))?;
+    let format = reader.format();
+    match format {
+        Some(ImageFormat::Png) => check_png_complete(bytes)?,
+        Some(ImageFormat::Jpeg) => check_jpeg_complete(bytes)?,
+        _ => return Err("not a PNG or JPEG image".into()),
+    }
+    let mut decoder = reader
+        .into_decoder()
+        .map_err(|e| format!("cannot decode image: {e}"))?;
+    let (width, height) = decoder.dimensions();
+    if width == 0 || height == 0 {
+        return Err(format!("image is {width} x {height}; it must not be empty"));
+    }
+    if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+        return Err(format!(
+            "image is {width} x {height}; the limit is {MAX_TEXTURE_SIZE} per side"
+        ));
+    }
+    // The size check above bounds the allocation: at most 16384² RGBA16 = 2 GiB.
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIZE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIZE);
+    limits.max_alloc = Some(u64::from(MAX_TEXTURE_SIZE).pow(2) * 8);
+    decoder
+        .set_limits(limits)
+        .map_err(|e| format!("cannot decode image: {e}"))?;
+    let image = image::DynamicImage::from_decoder(decoder)
+        .map_err(|e| format!("cannot decode image: {e}"))?;
+    // Any channel count and depth to RGBA8 (16-bit rounds to nearest).
+    let rgba = image.to_rgba8();
+    let (width, height) = rgba.dimensions();
+    Ok(Texture {
+        width,
+        height,
+        encoding,
+        rgba8: rgba.into_raw(),
+    })
+}
+
+/// Rejects a PNG whose chunk list stops before IEND (the decoder may accept a file
+/// cut after its last image-data chunk). Chunk layout: PNG spec §5.3.
+fn check_png_complete(bytes: &[u8]) -> Result<(), String> {
+    let mut pos: usize = 8; // after the 8-byte signature
+    loop {
+        let header = bytes
+            .get(pos..pos.saturating_add(8))
+            .ok_or("truncated PNG: the file ends before its IEND chunk")?;
+        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
+        let kind = &header[4..8];
+        // length, type, data, CRC
+        let next = pos
+            .checked_add(12)
+            .and_then(|p| p.checked_add(length))
+            .ok_or("corrupt PNG: chunk length overflows")?;
+        if next > bytes.len() {
+            return Err("truncated PNG: the file ends inside a chunk".into());
+        }
+        if kind == b"IEND" {
+            return Ok(());
+        }
+        pos = next;
+    }
+}
+
+/// Rejects a JPEG without an end-of-image marker after its scans (the decoder
+/// fills a cut-off image with grey instead of failing). Marker syntax: ITU T.81 §B.1.
+fn check_jpeg_complete(bytes: &[u8]) -> Result<(), String> {
+    const TRUNCATED: &str = "truncated JPEG: no end-of-image marker";
+    let mut pos: usize = 2; // after SOI (FF D8)
+    loop {
+        // A marker is FF (possibly repeated as fill) followed by a code.
+        if bytes.get(pos) != Some(&0xFF) {
+            return Err(if pos >= bytes.len() {
+                TRUNCATED.into()
+            } else {
+                format!("corrupt JPEG: expected a marker at byte {pos}")
+            });
+        }
+        while bytes.get(pos) == Some(&0xFF) {
+            pos += 1;
+        }
+        let code = *bytes.get(pos).ok_or(TRUNCATED)?;
+        pos += 1;
+        match code {
+            0xD9 => return Ok(()),          // EOI
+            0x01 | 0xD0..=0xD8 => continue, // stand-alone markers
+            _ => {}
+        }
+        let len_bytes = bytes.get(pos..pos + 2).ok_or(TRUNCATED)?;
+        let length = usize::from(u16::from_be_bytes([len_bytes[0], len_bytes[1]]));
+        if length < 2 {
+            return Err(format!(
+                "corrupt JPEG: segment length {length} at byte {pos}"
+            ));
+        }
+        pos += length;
+        if pos > bytes.len() {
+            return Err(TRUNCATED.into());
+        }
+        if code == 0xDA {
+            // Entropy-coded data follows SOS: skip to the next marker that is not a
+            // stuffed byte (FF 00), a restart marker (FF D0..D7) or fill (FF FF).
+            loop {
+                let byte = *bytes.get(pos).ok_or(TRUNCATED)?;
+                if byte == 0xFF {
+                    match *bytes.get(pos + 1).ok_or(TRUNCATED)? {
+                        0x00 | 0xD0..=0xD7 => pos += 2,
+                        0xFF => pos += 1,
+                        _ => break,
+                    }
+                } else {
+                    pos += 1;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn assets() -> Option<PathBuf> {
+        let dir = std::env::var_os("DERMIS_ASSETS")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| {
+                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
+            });
+        if dir.join("head/lee-perry-smith").is_dir() {
+            Some(dir.join("head/lee-perry-smith"))
+        } else {
+            println!(
+                "skipping: test assets not found at {} (set DERMIS_ASSETS)",
+                dir.display()
+            );
+            None
+        }
+    }
+
+    /// A fresh directory under the system temp dir, unique per test.
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!(
+            "dermis-texture-{name}-{}-{:?}",
+            std::process::id(),
+            std::time::SystemTime::now()
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn png_bytes(img: image::DynamicImage) -> Vec<u8> {
+        let mut out = Cursor::new(Vec::new());
+        img.write_to(&mut out, ImageFormat::Png).unwrap();
+        out.into_inner()
+    }
+
+    #[test]
+    fn solid_is_one_pixel() {
+        let t = Texture::solid([1, 2, 3, 4], Encoding::Linear);
+        assert_eq!((t.width, t.height), (1, 1));
+        assert_eq!(t.rgba8, vec![1, 2, 3, 4]);
+        assert_eq!(t.encoding, Encoding::Linear);
+    }
+
+    #[test]
+    fn lee_perry_smith_maps_load() {
+        let Some(dir) = assets() else { return };
+        for (name, enc) in [
+            ("Map-COL.jpg", Encoding::Srgb),
+            ("Map-SPEC.jpg", Encoding::Linear),
+            ("Infinite-Level_02_Tangent_SmoothUV.jpg", Encoding::Linear),
+        ] {
+            let t = load_texture(&dir.join(name), enc).unwrap();
+            assert_eq!((t.width, t.height), (1024, 1024), "{name}");
+            assert_eq!(t.rgba8.len(), 1024 * 1024 * 4, "{name}");
+            assert_eq!(t.encoding, enc);
+            // Alpha is opaque and the image is not blank.
+            assert!(t.rgba8.chunks_exact(4).all(|p| p[3] == 255), "{name}");
+            let first = &t.rgba8[0..3];
+            assert!(t.rgba8.chunks_exact(4).any(|p| &p[0..3] != first), "{name}");
+        }
+        // A tangent-space normal map points mostly along +Z: blue channel high.
+        let n = load_texture(
+            &dir.join("Infinite-Level_02_Tangent_SmoothUV.jpg"),
+            Encoding::Linear,
+        )
+        .unwrap();
+        let mean_b: f64 = n
+            .rgba8
+            .chunks_exact(4)
+            .map(|p| f64::from(p[2]))
+            .sum::<f64>()
+            / (1024.0 * 1024.0);
+        assert!(mean_b > 200.0, "mean blue {mean_b}");
+    }
+
+    #[test]
+    fn grey_and_16_bit_png_become_rgba8() {
+        let dir = temp_dir("png16");
+        // 16-bit grey, 2 x 1: 0 and 65535 -> 0 and 255, replicated to RGB.
+        let grey =
+            image::ImageBuffer::<image::Luma<u16>, _>::from_raw(2, 1, vec![0u16, 65535]).unwrap();
+        let path = dir.join("grey16.png");
+        std::fs::write(&path, png_bytes(image::DynamicImage::ImageLuma16(grey))).unwrap();
+        let t = load_texture(&path, Encoding::Linear).unwrap();
+        assert_eq!((t.width, t.height), (2, 1));
+        assert_eq!(t.rgba8, vec![0, 0, 0, 255, 255, 255, 255, 255]);
+        // 8-bit grey + alpha.
+        let la = image::ImageBuffer::<image::LumaA<u8>, _>::from_raw(1, 1, vec![10u8, 20]).unwrap();
+        let path = dir.join("la.png");
+        std::fs::write(&path, png_bytes(image::DynamicImage::ImageLumaA8(la))).unwrap();
+        let t = load_texture(&path, Encoding::Srgb).unwrap();
+        assert_eq!(t.rgba8, vec![10, 10, 10, 20]);
+        // 16-bit RGB: 0x8080 rounds to 0x80.
+        let rgb =
+            image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(1, 1, vec![0x8080u16, 0, 65535])
+                .unwrap();
+        let path = dir.join("rgb16.png");
+        std::fs::write(&path, png_bytes(image::DynamicImage::ImageRgb16(rgb))).unwrap();
+        let t = load_texture(&path, Encoding::Linear).unwrap();
+        assert_eq!(t.rgba8, vec![0x80, 0, 255, 255]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn oversized_image_is_rejected_before_decoding() {
+        let dir = temp_dir("huge");
+        // A valid 1 x 1 PNG whose IHDR claims 20000 x 1 (CRC recomputed).
+        let mut bytes = png_bytes(image::DynamicImage::new_rgba8(1, 1));
+        bytes[16..20].copy_from_slice(&20000u32.to_be_bytes());
+        let crc = crc32(&bytes[12..29]);
+        bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+        let path = dir.join("huge.png");
+        std::fs::write(&path, &bytes).unwrap();
+        let err = load_texture(&path, Encoding::Srgb).unwrap_err().to_string();
+        assert!(err.contains("huge.png") && err.contains("16384"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// CRC-32 as PNG uses it (ISO 3309), bitwise.
+    fn crc32(data: &[u8]) -> u32 {
+        let mut crc = 0xFFFF_FFFFu32;
+        for &b in data {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
+    #[test]
+    fn bad_images_give_errors_naming_the_file() {
+        let dir = temp_dir("bad");
+        let missing = dir.join("missing.png");
+        let err = load_texture(&missing, Encoding::Srgb)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("missing.png"), "{err}");
+
+        let png = png_bytes(image::DynamicImage::new_rgb8(64, 64));
+        let mut cases: Vec<(&str, Vec<u8>)> = vec![
+            ("empty.png", Vec::new()),
+            ("text.png", b"hello, not an image".to_vec()),
+            ("sig-only.png", png[..8].to_vec()),
+            ("cut-header.png", png[..20].to_vec()),
+            ("cut-middle.png", png[..png.len() / 2].to_vec()),
+            ("no-iend.png", png[..png.len() - 12].to_vec()),
+            ("cut-last.png", png[..png.len() - 1].to_vec()),
+        ];
+        // Corrupt PNG: a flipped byte inside IHDR breaks its CRC.
+        let mut bad_crc = png.clone();
+        bad_crc[20] ^= 0x40;
+        cases.push(("bad-crc.png", bad_crc));
+        if let Some(assets) = assets() {
+            let jpg = std::fs::read(assets.join("Map-COL.jpg")).unwrap();
+            cases.push(("cut-header.jpg", jpg[..100].to_vec()));
+            cases.push(("cut-middle.jpg", jpg[..jpg.len() / 2].to_vec()));
+            cases.push(("cut-end.jpg", jpg[..jpg.len() - 2].to_vec()));
+            let mut garbage = jpg[..2].to_vec();
+            garbage.extend_from_slice(&[0x12; 500]);
+            cases.push(("garbage.jpg", garbage));
+        }
+        for (name, bytes) in cases {
+            let path = dir.join(name);
+            std::fs::write(&path, &bytes).unwrap();
+            let result = load_texture(&path, Encoding::Srgb);
+            let err = result.err().unwrap_or_else(|| panic!("{name} loaded"));
+            let msg = err.to_string();
+            assert!(msg.contains(name), "{msg}");
+            assert!(!msg.contains('\n'), "{msg}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn fuzzed_jpeg_never_panics() {
+        let Some(assets) = assets() else { return };
+        let jpg = std::fs::read(assets.join("Map-COL.jpg")).unwrap();
+        let png = png_bytes(image::DynamicImage::new_rgb8(32, 32));
+        let mut rng = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            // xorshift64* (Vigna 2016)
+            rng ^= rng >> 12;
+            rng ^= rng << 25;
+            rng ^= rng >> 27;
+            rng.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        };
+        let (mut ok, mut err) = (0, 0);
+        for i in 0..240 {
+            let src = if i % 4 == 3 { &png } else { &jpg };
+            let mut bytes = src.clone();
+            if i % 2 == 0 {
+                bytes.truncate((next() as usize) % src.len());
+            } else {
+                for _ in 0..1 + next() % 8 {
+                    let at = (next() as usize) % bytes.len();
+                    bytes[at] ^= 1 << (next() % 8);
+                }
+            }
+            let outcome = std::panic::catch_unwind(|| {
+                decode_texture(&bytes, Encoding::Srgb)
+                    .map_err(|m| SceneError::texture(Path::new("fuzz.jpg"), m).to_string())
+            });
+            match outcome {
+                Ok(Ok(t)) => {
+                    assert_eq!(t.rgba8.len(), (t.width * t.height * 4) as usize);
+                    ok += 1
+                }
+                Ok(Err(msg)) => {
+                    assert!(!msg.contains('\n'), "{msg}");
+                    err += 1
+                }
+                Err(_) => panic!("decoder panicked on case {i}"),
+            }
+        }
+        println!("fuzzed images: {ok} decoded, {err} rejected");
+        assert!(err >= 120, "every truncation must be rejected");
+    }
+}
