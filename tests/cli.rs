@@ -143,3 +143,60 @@ fn no_driver_names_what_to_install() {
         "{stderr}"
     );
 }
+
+/// Runs `render` on bad input: exit status 2, one error line naming `needle`,
+/// no panic.
+fn assert_bad_input(args: &[&str], needle: &str) {
+    let out = dermis(
+        &[
+            &[
+                "render",
+                "--out",
+                tmp("bad.png").to_str().unwrap(),
+                "--width",
+                "32",
+                "--height",
+                "32",
+            ],
+            args,
+        ]
+        .concat(),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .unwrap_or_default();
+    assert!(line.contains(needle), "{args:?}: {stderr}");
+}
+
+#[test]
+fn bad_scene_input_is_a_clean_error() {
+    let glb = tmp("truncated.glb");
+    let real = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets/head/lee-perry-smith/LeePerrySmith.glb");
+    let bytes = std::fs::read(&real).unwrap_or_else(|_| b"glTF\x02\x00\x00\x00".repeat(64));
+    std::fs::write(&glb, &bytes[..bytes.len() / 3]).unwrap();
+    assert_bad_input(&["--mesh", glb.to_str().unwrap()], "truncated.glb");
+
+    let hdr = tmp("corrupt.hdr");
+    std::fs::write(
+        &hdr,
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 512 +X 1024\n\x02\x02",
+    )
+    .unwrap();
+    assert_bad_input(&["--env", hdr.to_str().unwrap()], "corrupt.hdr");
+
+    let toml = tmp("unknown.toml");
+    std::fs::write(&toml, "[render]\nwidth = 64\nfov = 3\n").unwrap();
+    assert_bad_input(&["--scene", toml.to_str().unwrap()], "line 3");
+
+    let toml = tmp("missing-texture.toml");
+    std::fs::write(&toml, "[textures]\nalbedo = \"no-such-albedo.png\"\n").unwrap();
+    assert_bad_input(&["--scene", toml.to_str().unwrap()], "no-such-albedo.png");
+
+    assert_bad_input(&["--env", "uniform:1,nan,1"], "uniform");
+    assert_bad_input(&["--irradiance-res", "3000"], "irradiance_resolution");
+}

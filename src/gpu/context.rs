@@ -204,6 +204,18 @@ impl Context {
         let _ = unsafe { du.set_debug_utils_object_name(&info) };
     }
 
+    /// Whether sampled images of `format` support linear filtering (optional for
+    /// 32-bit float formats in Vulkan).
+    pub fn supports_linear_filter(&self, format: vk::Format) -> bool {
+        let props = unsafe {
+            self.instance
+                .get_physical_device_format_properties(self.physical, format)
+        };
+        props
+            .optimal_tiling_features
+            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+    }
+
     pub fn wait_idle(&self) -> Result<()> {
         let _queue = self.queue();
         unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")

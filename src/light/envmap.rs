@@ -147,6 +147,8 @@ pub enum EnvSource {
     Uniform(Vec3),
     /// `sky` or `sky:elevation=30,azimuth=120,turbidity=3,intensity=1`.
     Sky(SkyParams),
+    /// `cube:PX,NX,PY,NY,PZ,NZ`: six face files (+X, −X, +Y, −Y, +Z, −Z).
+    CubeFaces([PathBuf; 6]),
     /// Anything else: a `.hdr` / `.exr` file.
     File(PathBuf),
 }
@@ -160,6 +162,10 @@ impl fmt::Display for EnvSource {
                 "sky:elevation={},azimuth={},turbidity={},intensity={}",
                 p.elevation_deg, p.azimuth_deg, p.turbidity, p.intensity
             ),
+            EnvSource::CubeFaces(faces) => {
+                let names: Vec<String> = faces.iter().map(|p| p.display().to_string()).collect();
+                write!(f, "cube:{}", names.join(","))
+            }
             EnvSource::File(p) => write!(f, "{}", p.display()),
         }
     }
@@ -951,6 +957,17 @@ pub fn parse_source(s: &str) -> Result<EnvSource, EnvError> {
     if t == "sky" {
         return Ok(EnvSource::Sky(SkyParams::default()));
     }
+    if let Some(rest) = t.strip_prefix("cube:") {
+        let faces: Vec<PathBuf> = rest.split(',').map(|p| PathBuf::from(p.trim())).collect();
+        return <[PathBuf; 6]>::try_from(faces)
+            .map(EnvSource::CubeFaces)
+            .map_err(|v| {
+                bad(format!(
+                    "expected six face files (+X,-X,+Y,-Y,+Z,-Z), got {}",
+                    v.len()
+                ))
+            });
+    }
     if let Some(rest) = t.strip_prefix("sky:") {
         let mut p = SkyParams::default();
         for kv in rest.split(',').map(str::trim).filter(|kv| !kv.is_empty()) {
@@ -988,6 +1005,7 @@ pub fn resolve(
 ) -> Result<(EnvMap, SanitizeReport), EnvError> {
     match src {
         EnvSource::File(p) => load(p),
+        EnvSource::CubeFaces(faces) => load_cube_faces(faces.each_ref().map(PathBuf::as_path)),
         _ if !size_ok(width, height) => Err(EnvError::BadSize { width, height }),
         EnvSource::Uniform(c) => {
             let mut env = EnvMap::uniform(*c, width, height);
@@ -1496,5 +1514,20 @@ mod tests {
         assert_eq!((sky.width, sky.height), (64, 32));
         let e = resolve(&EnvSource::File(PathBuf::from("/nonexistent/x.exr")), 1, 1).unwrap_err();
         assert!(e.to_string().contains("x.exr"));
+    }
+
+    #[test]
+    fn cube_face_sources_parse() {
+        let src = parse_source("cube:px.hdr, nx.hdr,py.hdr,ny.hdr,pz.hdr,nz.hdr").unwrap();
+        let EnvSource::CubeFaces(faces) = &src else {
+            panic!("{src:?}")
+        };
+        assert_eq!(faces[1], PathBuf::from("nx.hdr"));
+        assert_eq!(parse_source(&src.to_string()).unwrap(), src);
+        let e = parse_source("cube:a.hdr,b.hdr").unwrap_err().to_string();
+        assert!(e.contains("six face files"), "{e}");
+        // Missing faces are a load error naming the file.
+        let e = resolve(&src, 8, 4).unwrap_err().to_string();
+        assert!(e.contains("px.hdr"), "{e}");
     }
 }

@@ -79,6 +79,8 @@ pub struct ForwardInputs {
     pub albedo: Arc<Image>,
     pub normal: Arc<Image>,
     pub env: Arc<Image>,
+    /// Linear where the device filters RGBA32F, else nearest.
+    pub env_sampler: Arc<crate::gpu::Sampler>,
     pub samplers: Arc<Samplers>,
 }
 
@@ -99,7 +101,7 @@ pub fn passes(
             &pipe,
             &[
                 Descriptor::StaticUniform(&inp.uniforms),
-                Descriptor::StaticSampled(&inp.env, &inp.samplers.nearest),
+                Descriptor::StaticSampled(&inp.env, &inp.env_sampler),
             ],
         );
         cx.push_constants(&pipe, &[w as f32, h as f32]);

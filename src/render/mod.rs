@@ -122,6 +122,11 @@ pub fn render_scene(
         albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
         normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
         env: upload_env(ctx, &scene.env)?,
+        env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
+            samplers.linear.clone()
+        } else {
+            samplers.nearest.clone()
+        },
         samplers: samplers.clone(),
     });
     let forward = ForwardPipelines::new(ctx)?;

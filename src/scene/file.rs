@@ -132,7 +132,10 @@ impl Environment {
     /// True when `source` names a file rather than a built-in (`sky...`, `uniform:...`).
     pub fn source_is_path(&self) -> bool {
         let s = self.source.as_str();
-        !(s == "sky" || s.starts_with("sky:") || s.starts_with("uniform:"))
+        !(s == "sky"
+            || s.starts_with("sky:")
+            || s.starts_with("uniform:")
+            || s.starts_with("cube:"))
     }
 }
 
@@ -484,11 +487,12 @@ impl SceneFile {
         fix(&mut self.textures.specular);
         fix(&mut self.textures.roughness);
         fix(&mut self.textures.regions);
-        if self.environment.source_is_path() {
-            self.environment.source = base
-                .join(&self.environment.source)
-                .to_string_lossy()
-                .into_owned();
+        let join = |p: &str| base.join(p.trim()).to_string_lossy().into_owned();
+        if let Some(faces) = self.environment.source.strip_prefix("cube:") {
+            let faces: Vec<String> = faces.split(',').map(join).collect();
+            self.environment.source = format!("cube:{}", faces.join(","));
+        } else if self.environment.source_is_path() {
+            self.environment.source = join(&self.environment.source);
         }
     }
 
