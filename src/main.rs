@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
-use dermis::render::{render, RenderOptions};
+use dermis::render::{render, RenderOptions, View};
 use dermis::scene::file::{load_scene, SceneFile};
 use dermis::scene::Overrides;
 use std::path::PathBuf;
@@ -67,6 +67,9 @@ enum Command {
         width: Option<u32>,
         #[arg(long)]
         height: Option<u32>,
+        /// What to write: final, diffuse, direct, irradiance, stretch, blur1..blur6.
+        #[arg(long, default_value = "final")]
+        view: String,
         /// Frames to render; with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
@@ -148,6 +151,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             irradiance_res,
             width,
             height,
+            view,
             frames,
             timings,
             report,
@@ -172,6 +176,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 scene: overrides.apply(file)?,
                 frames,
                 hdr,
+                view: View::parse(&view)?,
                 context,
             })?;
             if dump_graph {

@@ -59,7 +59,7 @@ impl TestScene {
             pattern: Pipeline::compute(ctx, "pattern.comp", &[Binding::StorageImage], 8)?,
             blur: Pipeline::compute(
                 ctx,
-                "blur.comp",
+                "test_blur.comp",
                 &[Binding::SampledImage, Binding::StorageImage],
                 std::mem::size_of::<BlurPush>() as u32,
             )?,

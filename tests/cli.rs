@@ -34,6 +34,8 @@ fn render_writes_png_report_and_graph() {
         "render",
         "--out",
         png.to_str().unwrap(),
+        "--irradiance-res",
+        "256",
         "--width",
         "80",
         "--height",

@@ -28,6 +28,7 @@ fn render(mut file: SceneFile) -> RenderOutput {
     file.render.width = SIZE;
     file.render.height = SIZE;
     file.render.exposure = Some(0.0);
+    file.render.irradiance_resolution = 512;
     common::with_gpu(|ctx| {
         let scene = Scene::load(file).unwrap();
         let opts = RenderOptions {

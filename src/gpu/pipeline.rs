@@ -226,10 +226,6 @@ impl Pipeline {
         ctx.name(p.raw, &name);
         Ok(Arc::new(p))
     }
-
-    pub(crate) fn set_layout(&self) -> vk::DescriptorSetLayout {
-        self.set_layout
-    }
 }
 
 impl Drop for Pipeline {

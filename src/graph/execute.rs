@@ -36,6 +36,8 @@ pub enum Descriptor<'a> {
     Storage(BufferRef),
     /// A static uniform buffer outside the graph (uploaded with final access `UniformRead`).
     StaticUniform(&'a Buffer),
+    /// A static storage buffer outside the graph (uploaded with `ComputeBufferRead`).
+    StaticStorage(&'a Buffer),
 }
 
 /// What a pass's closure records with.
@@ -67,73 +69,72 @@ impl PassCx<'_> {
     }
 
     pub fn push_descriptors(&self, p: &Pipeline, descriptors: &[Descriptor]) {
-        let mut image_infos = Vec::with_capacity(descriptors.len());
-        let mut buffer_infos = Vec::with_capacity(descriptors.len());
-        for d in descriptors {
-            match *d {
-                Descriptor::StorageImage(r) => image_infos.push(vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: self.image(r).view,
-                    image_layout: vk::ImageLayout::GENERAL,
-                }),
-                Descriptor::Sampled(r, s) => image_infos.push(vk::DescriptorImageInfo {
-                    sampler: s.raw,
-                    image_view: self.image(r).view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }),
-                Descriptor::StaticSampled(i, s) => image_infos.push(vk::DescriptorImageInfo {
-                    sampler: s.raw,
-                    image_view: i.view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }),
-                Descriptor::Uniform(b) | Descriptor::Storage(b) => {
-                    buffer_infos.push(vk::DescriptorBufferInfo {
-                        buffer: self.buffer(b),
-                        offset: 0,
-                        range: vk::WHOLE_SIZE,
-                    })
-                }
-                Descriptor::StaticUniform(b) => buffer_infos.push(vk::DescriptorBufferInfo {
-                    buffer: b.raw,
-                    offset: 0,
-                    range: vk::WHOLE_SIZE,
-                }),
-            }
-        }
-        let (mut ii, mut bi) = (0, 0);
-        let writes: Vec<_> = descriptors
+        let image = |view, sampler: Option<&Sampler>, layout| vk::DescriptorImageInfo {
+            sampler: sampler.map_or(vk::Sampler::null(), |s| s.raw),
+            image_view: view,
+            image_layout: layout,
+        };
+        let buffer = |raw| vk::DescriptorBufferInfo {
+            buffer: raw,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        };
+        let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        // (type, image info, buffer info) per binding, in binding order.
+        let infos: Vec<_> = descriptors
+            .iter()
+            .map(|d| match *d {
+                Descriptor::StorageImage(r) => (
+                    vk::DescriptorType::STORAGE_IMAGE,
+                    Some(image(self.image(r).view, None, vk::ImageLayout::GENERAL)),
+                    None,
+                ),
+                Descriptor::Sampled(r, s) => (
+                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    Some(image(self.image(r).view, Some(s), read_only)),
+                    None,
+                ),
+                Descriptor::StaticSampled(i, s) => (
+                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    Some(image(i.view, Some(s), read_only)),
+                    None,
+                ),
+                Descriptor::Uniform(b) => (
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    None,
+                    Some(buffer(self.buffer(b))),
+                ),
+                Descriptor::Storage(b) => (
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    None,
+                    Some(buffer(self.buffer(b))),
+                ),
+                Descriptor::StaticUniform(b) => (
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    None,
+                    Some(buffer(b.raw)),
+                ),
+                Descriptor::StaticStorage(b) => (
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    None,
+                    Some(buffer(b.raw)),
+                ),
+            })
+            .collect();
+        let writes: Vec<_> = infos
             .iter()
             .enumerate()
-            .map(|(binding, d)| {
-                let w = vk::WriteDescriptorSet::default().dst_binding(binding as u32);
-                match d {
-                    Descriptor::Uniform(_)
-                    | Descriptor::Storage(_)
-                    | Descriptor::StaticUniform(_) => {
-                        let ty =
-                            if matches!(d, Descriptor::Uniform(_) | Descriptor::StaticUniform(_)) {
-                                vk::DescriptorType::UNIFORM_BUFFER
-                            } else {
-                                vk::DescriptorType::STORAGE_BUFFER
-                            };
-                        bi += 1;
-                        w.descriptor_type(ty)
-                            .buffer_info(std::slice::from_ref(&buffer_infos[bi - 1]))
-                    }
-                    _ => {
-                        let ty = if matches!(d, Descriptor::StorageImage(_)) {
-                            vk::DescriptorType::STORAGE_IMAGE
-                        } else {
-                            vk::DescriptorType::COMBINED_IMAGE_SAMPLER
-                        };
-                        ii += 1;
-                        w.descriptor_type(ty)
-                            .image_info(std::slice::from_ref(&image_infos[ii - 1]))
-                    }
+            .map(|(binding, (ty, img, buf))| {
+                let w = vk::WriteDescriptorSet::default()
+                    .dst_binding(binding as u32)
+                    .descriptor_type(*ty);
+                match (img, buf) {
+                    (Some(i), _) => w.image_info(std::slice::from_ref(i)),
+                    (_, Some(b)) => w.buffer_info(std::slice::from_ref(b)),
+                    _ => w,
                 }
             })
             .collect();
-        debug_assert!(p.set_layout() != vk::DescriptorSetLayout::null());
         unsafe {
             self.ctx.push_descriptor.cmd_push_descriptor_set(
                 self.cmd,

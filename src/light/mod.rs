@@ -2,5 +2,6 @@
 //! harmonics (Ramamoorthi & Hanrahan 2001; the paper's section III).
 
 pub mod envmap;
+pub mod occlusion;
 pub mod sh;
 pub mod sky;

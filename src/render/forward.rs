@@ -84,8 +84,8 @@ pub struct ForwardInputs {
     pub samplers: Arc<Samplers>,
 }
 
-/// Environment background, then the mesh over it, into `hdr`.
-pub fn passes(
+/// The environment seen through the camera, clearing `hdr`.
+pub fn background(
     g: &mut Graph,
     p: &ForwardPipelines,
     inputs: &Arc<ForwardInputs>,
@@ -107,9 +107,18 @@ pub fn passes(
         cx.push_constants(&pipe, &[w as f32, h as f32]);
         cx.draw(3, 1);
     });
+}
 
+/// The mesh with direct diffuse shading (no scattering) over `hdr`.
+pub fn direct(
+    g: &mut Graph,
+    p: &ForwardPipelines,
+    inputs: &Arc<ForwardInputs>,
+    hdr: &mut ImageHandle,
+) {
+    let (w, h) = (hdr.desc.width, hdr.desc.height);
     let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
-    let mut pass = g.add_pass("mesh");
+    let mut pass = g.add_pass("direct");
     pass.color_attachment(hdr, LoadOp::Load);
     pass.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
     let (pipe, inp) = (p.mesh.clone(), inputs.clone());

@@ -8,17 +8,65 @@ pub mod resources;
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, ContextOptions, DeviceInfo, ImageDesc, MemoryLocation};
 use crate::graph::upload::upload_buffer;
+use crate::graph::ImageHandle;
 use crate::graph::{Access, Executor, Graph};
 use crate::light::sh;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::profile::RunReport;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
+use crate::skin::blur::BlurChain;
+use crate::skin::irradiance::IrradiancePass;
+use crate::skin::shade::ShadePass;
+use crate::skin::stretch::StretchPass;
+use crate::skin::{mean_stretch, SkinSettings};
 use crate::testscene::readback_pass;
 use ash::vk;
 use forward::{ForwardInputs, ForwardPipelines, FrameUniforms, HDR_FORMAT, MAX_LIGHTS};
 use resources::{upload_env, upload_rgba8, MeshBuffers, Samplers};
 use std::sync::Arc;
+
+/// What `render` writes: the final image or one intermediate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// The final image: texture-space diffusion (+ specular when it lands).
+    Final,
+    /// The diffuse (subsurface) term alone.
+    Diffuse,
+    /// Direct diffuse shading in screen space, no scattering (for comparison).
+    Direct,
+    /// UV-space irradiance (coverage-premultiplied, as stored).
+    Irradiance,
+    /// UV-space stretch map (texels per mm in R and G; alpha = coverage).
+    Stretch,
+    /// UV-space blur level 1..=6 (as stored).
+    Blur(u8),
+}
+
+impl View {
+    pub fn parse(s: &str) -> Result<View> {
+        Ok(match s {
+            "final" => View::Final,
+            "diffuse" => View::Diffuse,
+            "direct" => View::Direct,
+            "irradiance" => View::Irradiance,
+            "stretch" => View::Stretch,
+            _ => match s.strip_prefix("blur").and_then(|k| k.parse::<u8>().ok()) {
+                Some(k @ 1..=6) => View::Blur(k),
+                _ => {
+                    return Err(Error::Input(format!(
+                    "unknown view {s:?}: final, diffuse, direct, irradiance, stretch, blur1..blur6"
+                )))
+                }
+            },
+        })
+    }
+
+    /// Whether the view is a UV-space target (written at irradiance resolution).
+    pub fn uv_space(self) -> bool {
+        matches!(self, View::Irradiance | View::Stretch | View::Blur(_))
+    }
+}
 
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -29,6 +77,7 @@ pub struct RenderOptions {
     pub frames: u32,
     /// Also read back the linear HDR image (for EXR output).
     pub hdr: bool,
+    pub view: View,
     pub context: ContextOptions,
 }
 
@@ -38,6 +87,7 @@ impl Default for RenderOptions {
             scene: SceneFile::default(),
             frames: 1,
             hdr: false,
+            view: View::Final,
             context: ContextOptions::from_env(),
         }
     }
@@ -102,59 +152,169 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
     u
 }
 
+/// GPU state shared by every frame of a render: uploaded scene and pipelines.
+struct Frame {
+    inputs: Arc<ForwardInputs>,
+    forward: ForwardPipelines,
+    stretch: StretchPass,
+    irradiance: IrradiancePass,
+    blur: BlurChain,
+    shade: ShadePass,
+    tonemap: Tonemap,
+    skin: SkinSettings,
+    constant_stretch: Option<f32>,
+    exposure: f32,
+}
+
+impl Frame {
+    fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
+        let (w, h) = (scene.file.render.width, scene.file.render.height);
+        let samplers = Arc::new(Samplers::new(ctx)?);
+        let uniforms = frame_uniforms(scene, w as f32 / h as f32);
+        let inputs = Arc::new(ForwardInputs {
+            uniforms: upload_buffer(
+                ctx,
+                "frame uniforms",
+                bytemuck::bytes_of(&uniforms),
+                Access::UniformRead,
+            )?,
+            mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
+            albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
+            normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
+            env: upload_env(ctx, &scene.env)?,
+            env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
+                samplers.linear.clone()
+            } else {
+                samplers.nearest.clone()
+            },
+            samplers: samplers.clone(),
+        });
+        let skin =
+            SkinSettings::from_scene(&scene.file.skin, scene.file.render.irradiance_resolution);
+        skin.profile
+            .validate()
+            .map_err(|e| Error::Input(format!("skin profile: {e}")))?;
+        let constant_stretch =
+            (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, skin.resolution));
+        Ok(Self {
+            forward: ForwardPipelines::new(ctx)?,
+            stretch: StretchPass::new(ctx)?,
+            irradiance: IrradiancePass::new(ctx)?,
+            blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
+            shade: ShadePass::new(ctx)?,
+            tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
+            inputs,
+            skin,
+            constant_stretch,
+            exposure: scene.exposure(),
+        })
+    }
+
+    /// Builds the frame graph; returns the image to read back (and its size)
+    /// for `view`, and for screen views the tone-mapped 8-bit image.
+    fn graph(
+        &self,
+        g: &mut Graph,
+        view: View,
+        (w, h): (u32, u32),
+    ) -> (ImageHandle, Option<ImageHandle>) {
+        let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
+        if view == View::Direct {
+            forward::background(g, &self.forward, &self.inputs, &mut hdr);
+            forward::direct(g, &self.forward, &self.inputs, &mut hdr);
+        } else {
+            let res = self.skin.resolution;
+            let mesh = &self.inputs.mesh;
+            let stretch = self.stretch.pass(g, mesh, res, self.constant_stretch);
+            let irradiance = self.irradiance.pass(g, &self.inputs, res, self.skin.mix);
+            if view == View::Stretch {
+                return (stretch, None);
+            }
+            if view == View::Irradiance {
+                return (irradiance, None);
+            }
+            let levels = self
+                .blur
+                .chain(g, &irradiance, &stretch, &self.skin.profile);
+            if let View::Blur(k) = view {
+                let mut irr = levels.irradiance;
+                return (irr.swap_remove(k as usize - 1), None);
+            }
+            forward::background(g, &self.forward, &self.inputs, &mut hdr);
+            let weights: Vec<_> = self
+                .skin
+                .profile
+                .gaussians
+                .iter()
+                .map(|g| g.weights)
+                .collect();
+            let weights: [glam::Vec3; 6] = weights.try_into().unwrap_or([glam::Vec3::ZERO; 6]);
+            self.shade.pass(
+                g,
+                &self.inputs,
+                &levels.irradiance,
+                weights,
+                self.skin.mix,
+                &mut hdr,
+            );
+        }
+        let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
+        self.tonemap.pass(g, &hdr, &mut ldr, self.exposure);
+        (hdr, Some(ldr))
+    }
+}
+
 pub fn render_scene(
     ctx: &Arc<Context>,
     scene: &Scene,
     opts: &RenderOptions,
 ) -> Result<RenderOutput> {
-    let (w, h) = (scene.file.render.width, scene.file.render.height);
-    check_target(&ctx.info, w, h)?;
-    let samplers = Arc::new(Samplers::new(ctx)?);
-    let uniforms = frame_uniforms(scene, w as f32 / h as f32);
-    let inputs = Arc::new(ForwardInputs {
-        uniforms: upload_buffer(
-            ctx,
-            "frame uniforms",
-            bytemuck::bytes_of(&uniforms),
-            Access::UniformRead,
-        )?,
-        mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
-        albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
-        normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
-        env: upload_env(ctx, &scene.env)?,
-        env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
-            samplers.linear.clone()
-        } else {
-            samplers.nearest.clone()
-        },
-        samplers: samplers.clone(),
-    });
-    let forward = ForwardPipelines::new(ctx)?;
-    let tonemap = Tonemap::new(ctx, samplers.nearest.clone())?;
-    let readback = |bytes_per_texel: u64| -> Result<Arc<Buffer>> {
+    let screen = (scene.file.render.width, scene.file.render.height);
+    check_target(&ctx.info, screen.0, screen.1)?;
+    let res = scene.file.render.irradiance_resolution;
+    check_target(&ctx.info, res, res)?;
+    if scene.file.skin.profile.len() != 6 {
+        return Err(Error::Input(format!(
+            "skin.profile has {} Gaussians; the blur chain and final shading use six",
+            scene.file.skin.profile.len()
+        )));
+    }
+    let frame = Frame::new(ctx, scene)?;
+    let (w, h) = if opts.view.uv_space() {
+        (res, res)
+    } else {
+        screen
+    };
+    let readback = |name: &str, bytes_per_texel: u64| -> Result<Arc<Buffer>> {
         Ok(Arc::new(Buffer::new(
             ctx,
-            "readback",
+            name,
             w as u64 * h as u64 * bytes_per_texel,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?))
     };
-    let ldr_readback = readback(4)?;
-    let hdr_readback = if opts.hdr { Some(readback(8)?) } else { None };
-    let exposure = scene.exposure();
-    log::info!("exposure {exposure:.2} EV");
+    let uv = opts.view.uv_space();
+    let ldr_readback = if uv {
+        None
+    } else {
+        Some(readback("readback ldr", 4)?)
+    };
+    let hdr_readback = if opts.hdr || uv {
+        Some(readback("readback hdr", 8)?)
+    } else {
+        None
+    };
 
     let mut executor = Executor::new(ctx, 2)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
     for _ in 0..opts.frames.max(1) {
         let mut g = Graph::new();
-        let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
-        forward::passes(&mut g, &forward, &inputs, &mut hdr);
-        let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
-        tonemap.pass(&mut g, &hdr, &mut ldr, exposure);
-        readback_pass(&mut g, &ldr, &ldr_readback);
+        let (hdr, ldr) = frame.graph(&mut g, opts.view, screen);
+        if let (Some(ldr), Some(buf)) = (&ldr, &ldr_readback) {
+            readback_pass(&mut g, ldr, buf);
+        }
         if let Some(buf) = &hdr_readback {
             readback_pass(&mut g, &hdr, buf);
         }
@@ -168,18 +328,24 @@ pub fn render_scene(
             .map(<[u8]>::to_vec)
             .ok_or_else(|| Error::Graph("readback buffer is not host-visible".into()))
     };
-    let rgba8 = mapped(&ldr_readback)?;
+    let exposure = frame.exposure;
+    // Screen views: linear radiance × 2^exposure. UV views: the values as stored.
     let hdr = match &hdr_readback {
         Some(b) => {
-            let scale = exposure.exp2();
+            let scale = if uv { 1.0 } else { exposure.exp2() };
             Some(
                 mapped(b)?
                     .chunks_exact(2)
                     .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32() * scale)
-                    .collect(),
+                    .collect::<Vec<f32>>(),
             )
         }
         None => None,
+    };
+    let rgba8 = match (&ldr_readback, &hdr) {
+        (Some(b), _) => mapped(b)?,
+        (None, Some(values)) => crate::output::encode_srgb8(values, exposure),
+        (None, None) => Vec::new(),
     };
     let report = RunReport::new(&ctx.info, w, h, reports, executor.pool_bytes());
     Ok(RenderOutput {

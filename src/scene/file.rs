@@ -314,6 +314,9 @@ pub struct Skin {
     /// Exactly [`REGION_COUNT`] regions.
     pub regions: Vec<SpecularRegion>,
     pub occlusion: Occlusion,
+    /// Correct blur widths for UV distortion with the stretch map (the paper's
+    /// section II.B); off: one texels-per-mm constant for the whole mesh.
+    pub stretch_correction: bool,
 }
 
 impl Default for Skin {
@@ -324,6 +327,7 @@ impl Default for Skin {
             profile: default_profile(),
             regions: default_regions(),
             occlusion: Occlusion::Raster,
+            stretch_correction: true,
         }
     }
 }

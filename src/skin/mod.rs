@@ -1,5 +1,105 @@
-//! The paper's skin model: the sum-of-Gaussians diffusion profile and the
-//! Kelemen/Szirmay-Kalos specular term (d'Eon & Luebke, GPU Gems 3 ch. 14).
+//! The paper's skin model on the render graph: texture-space diffusion (stretch
+//! map, irradiance, the six-Gaussian blur chain, final shading; GPU Gems 3 ch. 14
+//! and the paper's section II.B) and the Kelemen/Szirmay-Kalos specular term.
 
+pub mod blur;
+pub mod irradiance;
 pub mod profile;
+pub mod shade;
 pub mod specular;
+pub mod stretch;
+
+use crate::error::Result;
+use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
+use crate::render::resources::{Vertex, VERTEX_ATTRIBUTES};
+use crate::scene::file::{Kernel as KernelChoice, Skin};
+use crate::scene::mesh::Mesh;
+use ash::vk;
+use blur::BlurKernel;
+use glam::Vec3;
+use profile::{Gaussian, Kernel, Profile};
+use std::sync::Arc;
+
+/// Format of every UV-space target (irradiance, stretch, blur levels):
+/// coverage-premultiplied RGBA16F, as the design card fixes for the 4096² chain.
+pub const UV_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// Settings of texture-space diffusion, from the scene's `[skin]` and `[render]`.
+#[derive(Clone, Debug)]
+pub struct SkinSettings {
+    pub profile: Profile,
+    pub kernel: BlurKernel,
+    /// Pre-scatter share of the albedo (d'Eon & Luebke §14.5: 0.5).
+    pub mix: f32,
+    /// Side of the UV-space targets (power of two, 256..=8192).
+    pub resolution: u32,
+    /// Scale tap spacing by the per-texel stretch map; off: one constant
+    /// texels-per-mm for the whole mesh.
+    pub stretch_correction: bool,
+}
+
+impl SkinSettings {
+    pub fn from_scene(skin: &Skin, resolution: u32) -> Self {
+        Self {
+            profile: Profile {
+                gaussians: skin
+                    .profile
+                    .iter()
+                    .map(|g| Gaussian {
+                        variance_mm2: g.variance_mm2,
+                        weights: Vec3::from(g.weights),
+                    })
+                    .collect(),
+            },
+            kernel: match skin.kernel {
+                KernelChoice::Deon7 => BlurKernel::Fixed(Kernel::deon7()),
+                KernelChoice::Accurate => BlurKernel::Accurate,
+            },
+            mix: skin.mix,
+            resolution,
+            stretch_correction: skin.stretch_correction,
+        }
+    }
+}
+
+/// Texels per millimetre of the whole atlas: √(UV area in texels² / surface
+/// area in mm²), the constant used when stretch correction is off.
+pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
+    let (mut uv_area, mut area) = (0.0f64, 0.0f64);
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+        let p = |i: usize| mesh.positions[i];
+        area += 0.5 * (p(b) - p(a)).cross(p(c) - p(a)).length() as f64;
+        let (ua, ub, uc) = (mesh.uvs[a], mesh.uvs[b], mesh.uvs[c]);
+        uv_area += 0.5 * ((ub - ua).perp_dot(uc - ua)).abs() as f64;
+    }
+    let texels = uv_area * (resolution as f64).powi(2);
+    if area > 0.0 {
+        (texels / area).sqrt() as f32
+    } else {
+        1.0
+    }
+}
+
+/// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.
+pub(crate) fn uv_pipeline(
+    ctx: &Arc<Context>,
+    fragment: &str,
+    bindings: &[Binding],
+    push_constant_bytes: u32,
+) -> Result<Arc<Pipeline>> {
+    Pipeline::graphics(
+        ctx,
+        &GraphicsDesc {
+            vertex: "uv.vert",
+            fragment,
+            bindings,
+            push_constant_bytes,
+            color_formats: &[UV_FORMAT],
+            depth_format: None,
+            vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+            // UV charts may be mirrored: both windings are surface.
+            cull_mode: vk::CullModeFlags::NONE,
+        },
+    )
+}

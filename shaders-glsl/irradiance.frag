@@ -1,0 +1,29 @@
+#version 460
+// Irradiance in texture space (GPU Gems 3 §14.5): SH environment irradiance
+// (Ramamoorthi & Hanrahan 2001) plus directional lights, times the pre-scatter
+// albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter).
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+#include "sh.glsl"
+layout(binding = 1) uniform sampler2D albedo_tex;
+layout(binding = 2) uniform sampler2D normal_tex;
+layout(push_constant) uniform Push { float mix_pre; } pc;
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec2 v_uv;
+layout(location = 3) in vec4 v_tangent;
+layout(location = 0) out vec4 irradiance;
+
+void main() {
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
+    vec3 b = cross(n, t) * v_tangent.w;
+    vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
+    n = normalize(m.x * t + m.y * b + m.z * n);
+    vec3 e = max(sh_irradiance(frame.sh, n), vec3(0.0));
+    for (int i = 0; i < int(frame.env.z); ++i) {
+        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
+    }
+    vec3 albedo = texture(albedo_tex, v_uv).rgb;
+    irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
+}

@@ -1,0 +1,62 @@
+//! Irradiance in texture space (GPU Gems 3 §14.5): the mesh rasterised by its
+//! UVs, lit by the SH environment and explicit lights, times albedo^mix.
+
+use super::{uv_pipeline, UV_FORMAT};
+use crate::error::Result;
+use crate::gpu::{Binding, Context, ImageDesc, Pipeline};
+use crate::graph::{Descriptor, Graph, ImageHandle, LoadOp};
+use crate::render::forward::ForwardInputs;
+use std::sync::Arc;
+
+pub struct IrradiancePass {
+    pipeline: Arc<Pipeline>,
+}
+
+impl IrradiancePass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        Ok(Self {
+            pipeline: uv_pipeline(
+                ctx,
+                "irradiance.frag",
+                &[
+                    Binding::UniformBuffer,
+                    Binding::SampledImage,
+                    Binding::SampledImage,
+                ],
+                4,
+            )?,
+        })
+    }
+
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        inputs: &Arc<ForwardInputs>,
+        resolution: u32,
+        mix: f32,
+    ) -> ImageHandle {
+        let mut out = g.create_image(
+            "irradiance",
+            ImageDesc::new(resolution, resolution, UV_FORMAT),
+        );
+        let mut p = g.add_pass("irradiance");
+        p.color_attachment(&mut out, LoadOp::Clear([0.0; 4]));
+        let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(
+                &pipe,
+                &[
+                    Descriptor::StaticUniform(&inp.uniforms),
+                    Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
+                    Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
+                ],
+            );
+            cx.push_constants(&pipe, &mix);
+            cx.bind_vertex_buffer(&inp.mesh.vertices);
+            cx.bind_index_buffer(&inp.mesh.indices);
+            cx.draw_indexed(inp.mesh.index_count, 1);
+        });
+        out
+    }
+}

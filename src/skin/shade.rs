@@ -1,0 +1,82 @@
+//! Final skin shading in screen space (GPU Gems 3 §14.5; the paper's Fig. 2):
+//! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π.
+
+use crate::error::Result;
+use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
+use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
+use crate::render::forward::{ForwardInputs, DEPTH_FORMAT, HDR_FORMAT};
+use crate::render::resources::{Vertex, VERTEX_ATTRIBUTES};
+use ash::vk;
+use std::sync::Arc;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadePush {
+    weights: [[f32; 4]; 6],
+    mix_pre: f32,
+}
+
+pub struct ShadePass {
+    pipeline: Arc<Pipeline>,
+}
+
+impl ShadePass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let mut bindings = vec![Binding::UniformBuffer, Binding::SampledImage];
+        bindings.extend([Binding::SampledImage; 6]);
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "mesh.vert",
+                fragment: "skin.frag",
+                bindings: &bindings,
+                push_constant_bytes: std::mem::size_of::<ShadePush>() as u32,
+                color_formats: &[HDR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// Draws the mesh over `hdr` (which holds the background) with the six levels.
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        inputs: &Arc<ForwardInputs>,
+        levels: &[ImageHandle],
+        weights: [glam::Vec3; 6],
+        mix: f32,
+        hdr: &mut ImageHandle,
+    ) {
+        let (w, h) = (hdr.desc.width, hdr.desc.height);
+        let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
+        let mut p = g.add_pass("skin");
+        let refs: Vec<_> = levels
+            .iter()
+            .map(|l| p.read(l, Access::FragmentSampled))
+            .collect();
+        p.color_attachment(hdr, LoadOp::Load);
+        p.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
+        let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
+        let push = ShadePush {
+            weights: weights.map(|w| w.extend(0.0).into()),
+            mix_pre: mix,
+        };
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            let sampler = &inp.samplers.linear;
+            let mut d = vec![
+                Descriptor::StaticUniform(&inp.uniforms),
+                Descriptor::StaticSampled(&inp.albedo, sampler),
+            ];
+            d.extend(refs.iter().map(|&r| Descriptor::Sampled(r, sampler)));
+            cx.push_descriptors(&pipe, &d);
+            cx.push_constants(&pipe, &push);
+            cx.bind_vertex_buffer(&inp.mesh.vertices);
+            cx.bind_index_buffer(&inp.mesh.indices);
+            cx.draw_indexed(inp.mesh.index_count, 1);
+        });
+    }
+}

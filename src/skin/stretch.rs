@@ -1,0 +1,45 @@
+//! The stretch map (GPU Gems 3 §14.4.3; the paper's Fig. 3 top row): texels per
+//! mm along u and v for every texel, recomputed every frame so deforming meshes
+//! work.
+
+use super::{uv_pipeline, UV_FORMAT};
+use crate::error::Result;
+use crate::gpu::{Context, ImageDesc, Pipeline};
+use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::render::resources::MeshBuffers;
+use std::sync::Arc;
+
+pub struct StretchPass {
+    pipeline: Arc<Pipeline>,
+}
+
+impl StretchPass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        Ok(Self {
+            pipeline: uv_pipeline(ctx, "stretch.frag", &[], 4)?,
+        })
+    }
+
+    /// `constant`: `Some(texels_per_mm)` disables stretch correction.
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        mesh: &Arc<MeshBuffers>,
+        resolution: u32,
+        constant: Option<f32>,
+    ) -> ImageHandle {
+        let mut out = g.create_image("stretch", ImageDesc::new(resolution, resolution, UV_FORMAT));
+        let mut p = g.add_pass("stretch");
+        p.color_attachment(&mut out, LoadOp::Clear([0.0; 4]));
+        let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
+        let constant = constant.unwrap_or(0.0);
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_constants(&pipe, &constant);
+            cx.bind_vertex_buffer(&mesh.vertices);
+            cx.bind_index_buffer(&mesh.indices);
+            cx.draw_indexed(mesh.index_count, 1);
+        });
+        out
+    }
+}

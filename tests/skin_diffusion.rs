@@ -1,0 +1,263 @@
+//! Texture-space diffusion against analytic Gaussians (d'Eon & Luebke, GPU Gems 3
+//! §14.4; the paper's eq. 2-5): the real stretch pass and blur chain on flat
+//! planes whose UV scale is known, fed with chosen irradiance.
+
+mod common;
+
+use ash::vk;
+use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation, Sampler};
+use dermis::graph::upload::upload_texture;
+use dermis::graph::{Access, Executor, Graph, Imported};
+use dermis::render::resources::MeshBuffers;
+use dermis::scene::mesh::Mesh;
+use dermis::skin::blur::{BlurChain, BlurKernel};
+use dermis::skin::profile::{gaussian, Kernel, Profile};
+use dermis::skin::stretch::StretchPass;
+use dermis::skin::{mean_stretch, UV_FORMAT};
+use dermis::testscene::readback_pass;
+use glam::{Vec2, Vec3, Vec4};
+use std::sync::Arc;
+
+const N: u32 = 512;
+
+/// A plane of `lx` × `ly` mm in the XY plane whose UVs cover `[u0, u1]²`.
+fn plane(lx: f32, ly: f32, u0: f32, u1: f32) -> Mesh {
+    let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    Mesh {
+        name: "plane".into(),
+        positions: corners
+            .iter()
+            .map(|&(s, t)| Vec3::new(s * lx, t * ly, 0.0))
+            .collect(),
+        normals: vec![Vec3::Z; 4],
+        uvs: corners
+            .iter()
+            .map(|&(s, t)| Vec2::new(u0 + s * (u1 - u0), u0 + t * (u1 - u0)))
+            .collect(),
+        tangents: vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    }
+}
+
+fn accurate() -> BlurKernel {
+    BlurKernel::Accurate
+}
+
+/// Runs stretch + the six-level chain on `input` (N×N RGBA, alpha = coverage);
+/// returns each level normalised by its coverage (rgb / a).
+fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool) -> Vec<Vec<Vec3>> {
+    common::with_gpu(|ctx: &Arc<Context>| {
+        let texels: Vec<f32> = input.iter().flatten().copied().collect();
+        let bytes = common::to_f16_bytes(&texels);
+        let irr = upload_texture(ctx, "input", ImageDesc::new(N, N, UV_FORMAT), &bytes).unwrap();
+        let buffers = Arc::new(MeshBuffers::upload(ctx, mesh).unwrap());
+        let stretch = StretchPass::new(ctx).unwrap();
+        let blur =
+            BlurChain::new(ctx, kernel, Arc::new(Sampler::clamped(ctx, true).unwrap())).unwrap();
+        let readbacks: Vec<Arc<Buffer>> = (0..6)
+            .map(|_| {
+                Arc::new(
+                    Buffer::new(
+                        ctx,
+                        "level",
+                        (N * N * 8) as u64,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                        MemoryLocation::GpuToCpu,
+                    )
+                    .unwrap(),
+                )
+            })
+            .collect();
+        let mut g = Graph::new();
+        let input = g.import_image(
+            "input",
+            Imported::Image(irr.clone()),
+            Some(Access::ShaderSampled),
+            None,
+        );
+        let constant = (!correction).then(|| mean_stretch(mesh, N));
+        let st = stretch.pass(&mut g, &buffers, N, constant);
+        let levels = blur.chain(&mut g, &input, &st, &Profile::skin());
+        for (level, buf) in levels.irradiance.iter().zip(&readbacks) {
+            readback_pass(&mut g, level, buf);
+        }
+        let mut ex = Executor::new(ctx, 1).unwrap();
+        ex.run(g).unwrap();
+        ex.finish().unwrap();
+        readbacks
+            .iter()
+            .map(|b| {
+                common::from_f16_bytes(b.mapped().unwrap())
+                    .chunks_exact(4)
+                    .map(|p| {
+                        if p[3] > 1e-4 {
+                            Vec3::new(p[0], p[1], p[2]) / p[3]
+                        } else {
+                            Vec3::ZERO
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    })
+}
+
+/// Σ w_i · level_i with the skin profile's RGB weights (the paper's Fig. 2).
+fn combine(levels: &[Vec<Vec3>]) -> Vec<Vec3> {
+    let profile = Profile::skin();
+    (0..levels[0].len())
+        .map(|i| {
+            profile
+                .gaussians
+                .iter()
+                .zip(levels)
+                .map(|(g, l)| g.weights * l[i])
+                .sum()
+        })
+        .collect()
+}
+
+fn impulse(value: f32) -> Vec<[f32; 4]> {
+    let mut input = vec![[0.0, 0.0, 0.0, 1.0]; (N * N) as usize];
+    input[(N / 2 * N + N / 2) as usize] = [value, value, value, 1.0];
+    input
+}
+
+/// Max |GPU − analytic| along the row through the impulse, r ∈ [0, 3σ6], as a
+/// fraction of the analytic peak, per channel.
+fn profile_error(kernel: &BlurKernel) -> Vec3 {
+    let l = 18.0; // mm: 3σ6 = 8.2 mm fits in the half-width, σ1 = 2.3 texels
+    let a = l / N as f32; // mm per texel
+    let p = 100.0;
+    let out = combine(&chain(&plane(l, l, 0.0, 1.0), &impulse(p), kernel, true));
+    let profile = Profile::skin();
+    // The texture holds point samples: a unit sample of flux p·a² convolved with
+    // the profile is the profile itself, sampled at texel centres.
+    let reference = |r: f32| -> Vec3 {
+        profile
+            .gaussians
+            .iter()
+            .map(|g| g.weights * gaussian(g.variance_mm2, r))
+            .sum::<Vec3>()
+            * p
+            * a
+            * a
+    };
+    let peak = reference(0.0);
+    let sigma6 = profile.gaussians[5].variance_mm2.sqrt();
+    let row = (N / 2 * N) as usize;
+    let mut worst = Vec3::ZERO;
+    for dx in 0..=((3.0 * sigma6 / a) as usize) {
+        let got = out[row + (N / 2) as usize + dx];
+        let err = (got - reference(dx as f32 * a)).abs() / peak;
+        worst = worst.max(err);
+    }
+    worst
+}
+
+#[test]
+fn impulse_response_matches_the_sum_of_gaussians() {
+    let accurate = profile_error(&accurate());
+    let deon7 = profile_error(&BlurKernel::Fixed(Kernel::deon7()));
+    println!("max error / peak over r in [0, 3σ6]: accurate kernel {accurate:.4}, d'Eon 7-tap {deon7:.4}");
+    assert!(accurate.max_element() < 0.02, "accurate kernel: {accurate}");
+}
+
+/// World-space standard deviation (mm) of `values` along x and y.
+fn widths(values: &[f32], mm_per_texel: Vec2) -> Vec2 {
+    let (mut w, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for (i, &v) in values.iter().enumerate() {
+        let x = ((i as u32 % N) as f32 - (N / 2) as f32) * mm_per_texel.x;
+        let y = ((i as u32 / N) as f32 - (N / 2) as f32) * mm_per_texel.y;
+        w += v as f64;
+        sx += (v * x * x) as f64;
+        sy += (v * y * y) as f64;
+    }
+    Vec2::new((sx / w).sqrt() as f32, (sy / w).sqrt() as f32)
+}
+
+#[test]
+fn stretch_correction_makes_stretched_uvs_isotropic() {
+    // 18 × 36 mm mapped to the square: v texels are twice as long as u texels.
+    let mesh = plane(18.0, 36.0, 0.0, 1.0);
+    let texel = Vec2::new(18.0, 36.0) / N as f32;
+    let green = |levels: Vec<Vec<Vec3>>| combine(&levels).iter().map(|c| c.y).collect::<Vec<f32>>();
+    let on = widths(
+        &green(chain(&mesh, &impulse(100.0), &accurate(), true)),
+        texel,
+    );
+    let off = widths(
+        &green(chain(&mesh, &impulse(100.0), &accurate(), false)),
+        texel,
+    );
+    println!("world-space widths (mm): correction on {on}, off {off}");
+    let ratio = |w: Vec2| w.y / w.x;
+    assert!((ratio(on) - 1.0).abs() < 0.05, "on: {on}");
+    assert!(ratio(off) > 1.3, "off should be anisotropic: {off}");
+}
+
+/// A chart covering the UV square [0.25, 0.75]², gutter around it; `f(x, y)`
+/// gives the irradiance of covered texels.
+fn chart_input(f: impl Fn(u32, u32) -> f32) -> Vec<[f32; 4]> {
+    (0..N * N)
+        .map(|i| {
+            let (x, y) = (i % N, i / N);
+            let inside =
+                |t: u32| (t as f32 + 0.5) / N as f32 > 0.25 && ((t as f32 + 0.5) / N as f32) < 0.75;
+            if inside(x) && inside(y) {
+                let v = f(x, y);
+                [v, 0.5 * v, 0.25 * v, 1.0]
+            } else {
+                [0.0; 4]
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn uniform_irradiance_stays_uniform_up_to_the_chart_border() {
+    // 40 mm chart: the widest Gaussian reaches well past its border into the gutter.
+    let input = chart_input(|_, _| 1.0);
+    let out = combine(&chain(
+        &plane(40.0, 40.0, 0.25, 0.75),
+        &input,
+        &accurate(),
+        true,
+    ));
+    let mut worst = 0.0f32;
+    for (o, i) in out.iter().zip(&input) {
+        if i[3] > 0.0 {
+            let want = Vec3::new(i[0], i[1], i[2]);
+            worst = worst.max(((*o - want).abs() / want).max_element());
+        }
+    }
+    println!("uniform irradiance: max relative deviation {worst:.5}");
+    assert!(worst < 0.005, "{worst}");
+}
+
+#[test]
+fn flux_is_conserved_on_a_closed_chart() {
+    // A bright band away from the border and a dimmer rest.
+    let input = chart_input(|x, _| if (200..260).contains(&x) { 4.0 } else { 0.5 });
+    let out = combine(&chain(
+        &plane(40.0, 40.0, 0.25, 0.75),
+        &input,
+        &accurate(),
+        true,
+    ));
+    let covered = |i: usize| input[i][3] > 0.0;
+    let flux_in: f64 = (0..input.len())
+        .filter(|&i| covered(i))
+        .map(|i| input[i][0] as f64)
+        .sum();
+    let flux_out: f64 = (0..input.len())
+        .filter(|&i| covered(i))
+        .map(|i| out[i].x as f64)
+        .sum();
+    let change = (flux_out / flux_in - 1.0).abs();
+    println!(
+        "flux in {flux_in:.1}, out {flux_out:.1}: change {:.4}%",
+        change * 100.0
+    );
+    assert!(change < 0.01, "flux changed by {change}");
+}
