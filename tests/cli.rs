@@ -202,3 +202,77 @@ fn bad_scene_input_is_a_clean_error() {
     assert_bad_input(&["--env", "uniform:1,nan,1"], "uniform");
     assert_bad_input(&["--irradiance-res", "3000"], "irradiance_resolution");
 }
+
+#[test]
+fn views_write_intermediates() {
+    // UV-space views come out at the irradiance resolution, floats kept in EXR.
+    let exr = tmp("stretch.exr");
+    let out = dermis(&[
+        "render",
+        "--view",
+        "stretch",
+        "--irradiance-res",
+        "256",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        &exr,
+        |res, _| (res.width(), res.height(), Vec::new()),
+        |(_, _, px): &mut (usize, usize, Vec<[f32; 4]>), _, (r, g, b, a): (f32, f32, f32, f32)| {
+            px.push([r, g, b, a])
+        },
+    )
+    .unwrap();
+    let (w, h, px) = &img.layer_data.channel_data.pixels;
+    assert_eq!((*w, *h), (256, 256));
+    // Covered texels hold texels-per-mm: positive, finite, and the atlas is ~1 texel/mm at 256².
+    let covered: Vec<_> = px.iter().filter(|p| p[3] > 0.5).collect();
+    assert!(covered.len() > 256 * 256 / 10);
+    assert!(covered
+        .iter()
+        .all(|p| p[0] > 0.0 && p[0].is_finite() && p[1] > 0.0));
+    for view in ["blur6", "irradiance", "diffuse", "direct"] {
+        let png = tmp(&format!("{view}.png"));
+        let out = dermis(&[
+            "render",
+            "--view",
+            view,
+            "--irradiance-res",
+            "256",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            png.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{view}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let size = image::image_dimensions(&png).unwrap();
+        let uv = matches!(view, "blur6" | "irradiance");
+        assert_eq!(size, if uv { (256, 256) } else { (64, 48) }, "{view}");
+    }
+    let out = dermis(&[
+        "render",
+        "--view",
+        "blur7",
+        "--out",
+        tmp("x.png").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown view"));
+}

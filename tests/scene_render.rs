@@ -144,3 +144,126 @@ fn exr_is_the_linear_image_behind_the_png() {
     .unwrap();
     assert_eq!(read.layer_data.channel_data.pixels, *hdr);
 }
+
+/// Median of a list (sorted copy).
+fn median(mut v: Vec<f32>) -> f32 {
+    v.sort_by(f32::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Renders `file` close up and compares the luminance gradient across visible UV
+/// seams (mesh edges whose positions recur with other UVs) with the gradient a
+/// few pixels beside them. Returns (seam samples, median across, median beside).
+fn seam_gradients(mut file: SceneFile, distance_mm: f32) -> (usize, f32, f32) {
+    // Close on the face, so the widest Gaussians span several pixels.
+    let (w, h) = (512u32, 512u32);
+    file.render.width = w;
+    file.render.height = h;
+    file.render.irradiance_resolution = 2048;
+    file.camera.orbit = Some(dermis::scene::file::Orbit {
+        yaw_deg: 20.0,
+        pitch_deg: 5.0,
+        distance_mm,
+    });
+    file.render.exposure = Some(0.0);
+    let scene = Scene::load(file).unwrap();
+    let out = common::with_gpu(|ctx| {
+        let opts = RenderOptions {
+            hdr: true,
+            ..RenderOptions::default()
+        };
+        render_scene(ctx, &scene, &opts).unwrap()
+    });
+    let img = out.hdr.unwrap();
+    let luma = |x: i32, y: i32| -> Option<f32> {
+        if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
+            return None;
+        }
+        let p = &img[((y as u32 * w + x as u32) * 4) as usize..][..3];
+        Some(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+    };
+    // Seam edges: triangle edges whose positions recur elsewhere with other UVs.
+    let mesh = &scene.mesh;
+    let key = |i: u32| mesh.positions[i as usize].to_array().map(f32::to_bits);
+    let mut edges: std::collections::HashMap<_, Vec<(u32, u32)>> = Default::default();
+    for t in mesh.indices.chunks_exact(3) {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let k = if key(a) < key(b) {
+                (key(a), key(b))
+            } else {
+                (key(b), key(a))
+            };
+            edges.entry(k).or_default().push((a, b));
+        }
+    }
+    let vp = scene.camera.view_projection(w as f32 / h as f32);
+    let to_screen = |p: glam::Vec3| {
+        let c = vp.project_point3(p);
+        glam::Vec2::new((c.x * 0.5 + 0.5) * w as f32, (c.y * 0.5 + 0.5) * h as f32)
+    };
+    let (mut across, mut beside) = (Vec::new(), Vec::new());
+    for uses in edges.values() {
+        let uv = |(a, b): (u32, u32)| (mesh.uvs[a as usize], mesh.uvs[b as usize]);
+        let (a, b) = uses[0];
+        let is_seam = uses.iter().any(|&e| {
+            let (p, q) = uv(e);
+            let (r, s) = uv((a, b));
+            (p.distance(r) > 1e-4 || q.distance(s) > 1e-4)
+                && (p.distance(s) > 1e-4 || q.distance(r) > 1e-4)
+        });
+        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+        let n = (mesh.normals[a as usize] + mesh.normals[b as usize]).normalize();
+        let mid = 0.5 * (pa + pb);
+        // Only seams on surfaces facing the camera squarely (visible, not grazing).
+        if !is_seam || n.dot((scene.camera.position - mid).normalize()) < 0.6 {
+            continue;
+        }
+        let (sa, sb) = (to_screen(pa), to_screen(pb));
+        let m = 0.5 * (sa + sb);
+        let perp = (sb - sa).perp().normalize_or_zero();
+        let grad = |c: glam::Vec2| -> Option<f32> {
+            let (p, q) = (c + perp * 1.5, c - perp * 1.5);
+            Some(
+                (luma(p.x.round() as i32, p.y.round() as i32)?
+                    - luma(q.x.round() as i32, q.y.round() as i32)?)
+                .abs(),
+            )
+        };
+        if let (Some(g0), Some(g1), Some(g2)) =
+            (grad(m), grad(m + perp * 6.0), grad(m - perp * 6.0))
+        {
+            across.push(g0);
+            beside.push(0.5 * (g1 + g2));
+        }
+    }
+    let n = across.len();
+    if n == 0 {
+        return (0, 0.0, 0.0);
+    }
+    (n, median(across), median(beside))
+}
+
+fn assert_no_seams(what: &str, (n, seam, skin): (usize, f32, f32)) {
+    println!(
+        "{what}: {n} seam samples, median gradient across seams {seam:.4}, beside them {skin:.4}"
+    );
+    assert!(n > 20, "{what}: too few visible seam samples: {n}");
+    assert!(
+        seam < 1.5 * skin + 1e-3,
+        "{what}: seams stand out: {seam} vs {skin}"
+    );
+}
+
+#[test]
+fn texture_space_diffusion_leaves_no_seam_lines() {
+    // The built-in head's atlas has charts meeting on the face and the sides.
+    assert_no_seams("built-in head", seam_gradients(SceneFile::default(), 350.0));
+    // The scan's atlas is one cylindrical chart (seam at the back) plus small
+    // charts for the eyes and mouth: few of its seams face the camera.
+    let Some(_) = assets() else { return };
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes/lee-perry-smith.toml");
+    assert_no_seams(
+        "Lee Perry-Smith",
+        seam_gradients(load_scene(&path).unwrap(), 450.0),
+    );
+}

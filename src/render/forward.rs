@@ -78,6 +78,10 @@ pub struct ForwardInputs {
     pub mesh: Arc<MeshBuffers>,
     pub albedo: Arc<Image>,
     pub normal: Arc<Image>,
+    /// Specular intensity, roughness and face-region maps (read by the specular term).
+    pub specular: Arc<Image>,
+    pub roughness: Arc<Image>,
+    pub regions: Arc<Image>,
     pub env: Arc<Image>,
     /// Linear where the device filters RGBA32F, else nearest.
     pub env_sampler: Arc<crate::gpu::Sampler>,

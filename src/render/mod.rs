@@ -181,6 +181,9 @@ impl Frame {
             mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
             albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
             normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
+            specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
+            roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
+            regions: upload_rgba8(ctx, "region map", &scene.regions)?,
             env: upload_env(ctx, &scene.env)?,
             env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
                 samplers.linear.clone()

@@ -72,6 +72,8 @@ pub struct Scene {
     pub albedo: Texture,
     pub normal: Texture,
     pub specular: Texture,
+    /// Beckmann roughness m as grey/255; the default is d'Eon's m = 0.3 (77/255).
+    pub roughness: Texture,
     pub regions: Texture,
     pub env: EnvMap,
     pub camera: Camera,
@@ -122,6 +124,8 @@ impl Scene {
             }
         };
         let specular = load(&t.specular, Encoding::Linear, texture::DEFAULT_SPECULAR)?;
+        // m = 0.3 (GPU Gems 3 §14.3) encoded as grey/255.
+        let roughness = load(&t.roughness, Encoding::Linear, [77, 77, 77, 255])?;
         let source = envmap::parse_source(&file.environment.source)?;
         let (w, h) = PROCEDURAL_ENV_SIZE;
         let (env, report) = envmap::resolve(&source, w, h)?;
@@ -170,6 +174,7 @@ impl Scene {
             albedo,
             normal,
             specular,
+            roughness,
             regions,
             env,
             camera,
