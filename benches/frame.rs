@@ -1,8 +1,9 @@
-//! Per-pass GPU cost of the default frame (built-in head under the sky) at
-//! several output sizes: medians over warmed-up frames (the first frame of each
-//! size is warm-up: lavapipe compiles shaders on first use).
-//! `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 6) and
-//! `DERMIS_BENCH_SIZES` (default "512,1024,2048") tune it. Writes
+//! Per-pass GPU cost of the default frame (built-in head under the sky, 1280×720)
+//! against the irradiance (blur) resolution: medians over warmed-up frames (the
+//! first frame of each resolution is warm-up: lavapipe compiles shaders on first
+//! use). `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 4),
+//! `DERMIS_BENCH_SIZES` (irradiance sides, default "512,1024,2048,4096") and
+//! `DERMIS_BENCH_KERNEL` (`deon7` or `accurate`) tune it. Writes
 //! `target/bench-frame.json` for docs/performance.md.
 
 use dermis::gpu::{Context, ContextOptions};
@@ -14,25 +15,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: u32 = std::env::var("DERMIS_BENCH_FRAMES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(6);
+        .unwrap_or(4);
     let sizes: Vec<u32> = std::env::var("DERMIS_BENCH_SIZES")
-        .unwrap_or_else(|_| "512,1024,2048".into())
+        .unwrap_or_else(|_| "512,1024,2048,4096".into())
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     let ctx = Context::new(&ContextOptions::from_env())?;
-    let mut scene = Scene::load(SceneFile::default())?;
+    let mut file = SceneFile::default();
+    if std::env::var("DERMIS_BENCH_KERNEL").as_deref() == Ok("accurate") {
+        file.skin.kernel = dermis::scene::file::Kernel::Accurate;
+    }
+    let mut scene = Scene::load(file)?;
     let mut reports = Vec::new();
     for size in sizes {
-        scene.file.render.width = size;
-        scene.file.render.height = size;
+        scene.file.render.irradiance_resolution = size;
         let opts = RenderOptions {
             frames: frames.max(2),
             ..RenderOptions::default()
         };
         let r = render_scene(&ctx, &scene, &opts)?.report;
         println!(
-            "\n{size}x{size} on {} ({}), {} measured frames, LP_NUM_THREADS={}",
+            "\nirradiance {size}², output {}x{}, on {} ({}), {} measured frames, LP_NUM_THREADS={}",
+            r.width,
+            r.height,
             r.device,
             r.driver,
             r.frames - r.warmup_frames,
