@@ -8,6 +8,9 @@
 const float PI_F = 3.14159265358979;
 layout(binding = 1) uniform sampler2D albedo_tex;   // sRGB format: sampled linear
 layout(binding = 2) uniform sampler2D normal_tex;   // tangent space, [0,1] encoded
+// SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
+// (rgb), rotated and scaled by the environment intensity.
+layout(std430, binding = 3) readonly buffer Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -25,7 +28,7 @@ vec3 shading_normal() {
 
 void main() {
     vec3 n = shading_normal();
-    vec3 e = max(sh_irradiance(frame.sh, n), vec3(0.0));
+    vec3 e = max(sh_irradiance(lighting.sh, n), vec3(0.0));
     for (int i = 0; i < int(frame.env.z); ++i) {
         e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
     }

@@ -8,6 +8,9 @@
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 layout(push_constant) uniform Push { float mix_pre; } pc;
+// SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
+// (rgb), rotated and scaled by the environment intensity.
+layout(std430, binding = 3) readonly buffer Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -20,7 +23,7 @@ void main() {
     vec3 b = cross(n, t) * v_tangent.w;
     vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
     n = normalize(m.x * t + m.y * b + m.z * n);
-    vec3 e = max(sh_irradiance(frame.sh, n), vec3(0.0));
+    vec3 e = max(sh_irradiance(lighting.sh, n), vec3(0.0));
     for (int i = 0; i < int(frame.env.z); ++i) {
         e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
     }

@@ -36,6 +36,20 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Print an environment's 27 SH coefficients (9 per channel), projected on the GPU.
+    Sh {
+        /// A .hdr/.exr file, a cross, `cube:...`, `uniform:R,G,B` or `sky[:...]`.
+        env: String,
+        /// Rotation about +Y, degrees.
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        rotate: f32,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Also print the GPU passes' timings.
+        #[arg(long)]
+        timings: bool,
+    },
     /// Render the scene to an image (the built-in head under the sky by default).
     Render {
         /// TOML scene file (see docs/scene-format.md).
@@ -137,6 +151,38 @@ fn run(cli: Cli) -> dermis::Result<()> {
                         }
                     );
                 }
+            }
+            Ok(())
+        }
+        Command::Sh {
+            env,
+            rotate,
+            json,
+            timings,
+        } => {
+            let (w, h) = dermis::scene::PROCEDURAL_ENV_SIZE;
+            let (map, _) =
+                dermis::light::envmap::resolve(&dermis::light::envmap::parse_source(&env)?, w, h)?;
+            let ctx = Context::new(&context)?;
+            let (coeffs, report) = dermis::light::sh_pass::project(&ctx, &map, rotate, 1.0)?;
+            let names = [
+                "L00", "L1-1", "L10", "L11", "L2-2", "L2-1", "L20", "L21", "L22",
+            ];
+            if json {
+                let obj: serde_json::Map<String, serde_json::Value> = names
+                    .iter()
+                    .zip(&coeffs)
+                    .map(|(n, c)| (n.to_string(), serde_json::json!([c.x, c.y, c.z])))
+                    .collect();
+                let out = serde_json::json!({ "environment": env, "rotation_deg": rotate, "order": names, "coefficients": obj });
+                println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+            } else {
+                for (n, c) in names.iter().zip(&coeffs) {
+                    println!("{n:<5} {:>14.6} {:>14.6} {:>14.6}", c.x, c.y, c.z);
+                }
+            }
+            if timings {
+                eprint!("{}", report.table());
             }
             Ok(())
         }

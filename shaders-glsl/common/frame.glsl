@@ -3,7 +3,6 @@ layout(std140, binding = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
     vec4 camera_pos;        // xyz mm
-    vec4 sh[9];             // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (rgb), scaled by intensity
     vec4 light_dir[4];      // xyz: direction towards the light
     vec4 light_color[4];    // rgb: irradiance on a surface facing it
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count

@@ -31,6 +31,8 @@ pub enum Access {
     ComputeBufferRead,
     /// Storage buffer write in a compute shader.
     ComputeBufferWrite,
+    /// Storage buffer read in a fragment shader.
+    FragmentBufferRead,
     VertexBuffer,
     IndexBuffer,
     /// Uniform buffer read by any shader stage.
@@ -127,6 +129,12 @@ impl Access {
                 L::UNDEFINED,
                 true,
             ),
+            Access::FragmentBufferRead => (
+                S::FRAGMENT_SHADER,
+                A::SHADER_STORAGE_READ,
+                L::UNDEFINED,
+                false,
+            ),
             Access::VertexBuffer => (
                 S::VERTEX_ATTRIBUTE_INPUT,
                 A::VERTEX_ATTRIBUTE_READ,
@@ -156,6 +164,7 @@ impl Access {
             self,
             Access::ComputeBufferRead
                 | Access::ComputeBufferWrite
+                | Access::FragmentBufferRead
                 | Access::VertexBuffer
                 | Access::IndexBuffer
                 | Access::UniformRead
@@ -189,7 +198,9 @@ impl Access {
     pub fn buffer_usage(self) -> vk::BufferUsageFlags {
         use vk::BufferUsageFlags as U;
         match self {
-            Access::ComputeBufferRead | Access::ComputeBufferWrite => U::STORAGE_BUFFER,
+            Access::ComputeBufferRead | Access::ComputeBufferWrite | Access::FragmentBufferRead => {
+                U::STORAGE_BUFFER
+            }
             Access::VertexBuffer => U::VERTEX_BUFFER,
             Access::IndexBuffer => U::INDEX_BUFFER,
             Access::UniformRead => U::UNIFORM_BUFFER,

@@ -4,4 +4,5 @@
 pub mod envmap;
 pub mod occlusion;
 pub mod sh;
+pub mod sh_pass;
 pub mod sky;

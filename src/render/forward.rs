@@ -4,7 +4,7 @@
 use super::resources::{MeshBuffers, Samplers, Vertex, VERTEX_ATTRIBUTES};
 use crate::error::Result;
 use crate::gpu::{Binding, Buffer, Context, GraphicsDesc, Image, Pipeline};
-use crate::graph::{Descriptor, Graph, ImageHandle, LoadOp};
+use crate::graph::{Access, BufferHandle, Descriptor, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -19,7 +19,6 @@ pub struct FrameUniforms {
     pub view_proj: [[f32; 4]; 4],
     pub inv_view_proj: [[f32; 4]; 4],
     pub camera_pos: [f32; 4],
-    pub sh: [[f32; 4]; 9],
     pub light_dir: [[f32; 4]; 4],
     pub light_color: [[f32; 4]; 4],
     /// x: environment rotation (radians about +Y), y: intensity, z: light count.
@@ -59,6 +58,7 @@ impl ForwardPipelines {
                     Binding::UniformBuffer,
                     Binding::SampledImage,
                     Binding::SampledImage,
+                    Binding::StorageBuffer,
                 ],
                 push_constant_bytes: 0,
                 color_formats: &[HDR_FORMAT],
@@ -113,16 +113,19 @@ pub fn background(
     });
 }
 
-/// The mesh with direct diffuse shading (no scattering) over `hdr`.
+/// The mesh with direct diffuse shading (no scattering) over `hdr`; `sh`: the
+/// environment's coefficients (light::sh_pass).
 pub fn direct(
     g: &mut Graph,
     p: &ForwardPipelines,
     inputs: &Arc<ForwardInputs>,
+    sh: &BufferHandle,
     hdr: &mut ImageHandle,
 ) {
     let (w, h) = (hdr.desc.width, hdr.desc.height);
     let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
     let mut pass = g.add_pass("direct");
+    let coeffs = pass.read_buffer(sh, Access::FragmentBufferRead);
     pass.color_attachment(hdr, LoadOp::Load);
     pass.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
     let (pipe, inp) = (p.mesh.clone(), inputs.clone());
@@ -134,6 +137,7 @@ pub fn direct(
                 Descriptor::StaticUniform(&inp.uniforms),
                 Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
                 Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
+                Descriptor::Storage(coeffs),
             ],
         );
         cx.bind_vertex_buffer(&inp.mesh.vertices);

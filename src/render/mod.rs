@@ -10,7 +10,7 @@ use crate::gpu::{Buffer, Context, ContextOptions, DeviceInfo, ImageDesc, MemoryL
 use crate::graph::upload::upload_buffer;
 use crate::graph::ImageHandle;
 use crate::graph::{Access, Executor, Graph};
-use crate::light::sh;
+use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::profile::RunReport;
 use crate::scene::file::SceneFile;
@@ -123,16 +123,14 @@ pub fn render(opts: &RenderOptions) -> Result<RenderOutput> {
     render_scene(&ctx, &scene, opts)
 }
 
-/// The frame's uniforms: camera, SH lighting (rotated and scaled), lights, exposure.
+/// The frame's uniforms: camera, environment rotation and intensity, lights, exposure.
 pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let env = &scene.file.environment;
-    let coeffs = sh::rotate_y(&sh::project(&scene.env), env.rotation_deg);
     let mut u = FrameUniforms {
         view_proj: vp.to_cols_array_2d(),
         inv_view_proj: vp.inverse().to_cols_array_2d(),
         camera_pos: scene.camera.position.extend(1.0).into(),
-        sh: coeffs.map(|c| (c * env.intensity).extend(0.0).into()),
         light_dir: [[0.0; 4]; MAX_LIGHTS],
         light_color: [[0.0; 4]; MAX_LIGHTS],
         env: [env.rotation_deg.to_radians(), env.intensity, 0.0, 0.0],
@@ -161,6 +159,8 @@ struct Frame {
     blur: BlurChain,
     shade: ShadePass,
     tonemap: Tonemap,
+    sh: ShPasses,
+    sh_buffers: ShBuffers,
     skin: SkinSettings,
     constant_stretch: Option<f32>,
     exposure: f32,
@@ -206,6 +206,13 @@ impl Frame {
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx)?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
+            sh: ShPasses::new(ctx, samplers.nearest.clone())?,
+            sh_buffers: ShBuffers::new(
+                ctx,
+                &inputs.env,
+                scene.file.environment.rotation_deg,
+                scene.file.environment.intensity,
+            )?,
             inputs,
             skin,
             constant_stretch,
@@ -222,14 +229,22 @@ impl Frame {
         (w, h): (u32, u32),
     ) -> (ImageHandle, Option<ImageHandle>) {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
+        let sh = self.sh.passes(
+            g,
+            &self.inputs.env,
+            &self.sh_buffers,
+            Access::FragmentBufferRead,
+        );
         if view == View::Direct {
             forward::background(g, &self.forward, &self.inputs, &mut hdr);
-            forward::direct(g, &self.forward, &self.inputs, &mut hdr);
+            forward::direct(g, &self.forward, &self.inputs, &sh, &mut hdr);
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
             let stretch = self.stretch.pass(g, mesh, res, self.constant_stretch);
-            let irradiance = self.irradiance.pass(g, &self.inputs, res, self.skin.mix);
+            let irradiance = self
+                .irradiance
+                .pass(g, &self.inputs, &sh, res, self.skin.mix);
             if view == View::Stretch {
                 return (stretch, None);
             }

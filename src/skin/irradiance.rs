@@ -4,7 +4,7 @@
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::gpu::{Binding, Context, ImageDesc, Pipeline};
-use crate::graph::{Descriptor, Graph, ImageHandle, LoadOp};
+use crate::graph::{Access, BufferHandle, Descriptor, Graph, ImageHandle, LoadOp};
 use crate::render::forward::ForwardInputs;
 use std::sync::Arc;
 
@@ -22,16 +22,19 @@ impl IrradiancePass {
                     Binding::UniformBuffer,
                     Binding::SampledImage,
                     Binding::SampledImage,
+                    Binding::StorageBuffer,
                 ],
                 4,
             )?,
         })
     }
 
+    /// `sh`: the environment's coefficients (light::sh_pass).
     pub fn pass(
         &self,
         g: &mut Graph,
         inputs: &Arc<ForwardInputs>,
+        sh: &BufferHandle,
         resolution: u32,
         mix: f32,
     ) -> ImageHandle {
@@ -40,6 +43,7 @@ impl IrradiancePass {
             ImageDesc::new(resolution, resolution, UV_FORMAT),
         );
         let mut p = g.add_pass("irradiance");
+        let coeffs = p.read_buffer(sh, Access::FragmentBufferRead);
         p.color_attachment(&mut out, LoadOp::Clear([0.0; 4]));
         let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
         p.record(move |cx| {
@@ -50,6 +54,7 @@ impl IrradiancePass {
                     Descriptor::StaticUniform(&inp.uniforms),
                     Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
                     Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
+                    Descriptor::Storage(coeffs),
                 ],
             );
             cx.push_constants(&pipe, &mix);

@@ -1,0 +1,215 @@
+//! SH projection of the environment on the GPU (the paper's eq. 10; Ramamoorthi &
+//! Hanrahan 2001), as two timed graph passes: `sh_project` (one workgroup per
+//! row) and `sh_reduce` (sum, rotate, scale). `light::sh::project` is the CPU
+//! reference it is tested against.
+
+use super::envmap::EnvMap;
+use super::sh::{self, Sh9};
+use crate::error::{Error, Result};
+use crate::gpu::{Binding, Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
+use crate::graph::upload::upload_buffer;
+use crate::graph::{Access, BufferHandle, Descriptor, Executor, Graph, Imported};
+use crate::profile::FrameReport;
+use ash::vk;
+use glam::{Mat3, Vec3};
+use std::sync::Arc;
+
+/// The 9×9 block-diagonal matrix M with rotate_y(L, degrees) = M·L (row-major).
+pub fn rotation_matrix(degrees: f32) -> [f32; 81] {
+    let r = Mat3::from_rotation_y(degrees.to_radians());
+    let mut m = [0.0; 81];
+    for j in 0..9 {
+        let mut e: Sh9 = [Vec3::ZERO; 9];
+        e[j] = Vec3::X;
+        for (i, c) in sh::rotate(&e, r).iter().enumerate() {
+            m[i * 9 + j] = c.x;
+        }
+    }
+    m
+}
+
+pub struct ShPasses {
+    project: Arc<Pipeline>,
+    reduce: Arc<Pipeline>,
+    sampler: Arc<Sampler>,
+}
+
+/// Buffers of one environment's projection, reused frame after frame.
+pub struct ShBuffers {
+    partials: Arc<Buffer>,
+    transform: Arc<Buffer>,
+    /// Nine vec4 (rgb, 0): rotated and scaled coefficients.
+    pub coefficients: Arc<Buffer>,
+    rows: u32,
+}
+
+impl ShBuffers {
+    pub fn new(ctx: &Arc<Context>, env: &Image, rotation_deg: f32, intensity: f32) -> Result<Self> {
+        let rows = env.desc.height;
+        let storage = |name: &str, size: u64, extra: vk::BufferUsageFlags| {
+            Buffer::new(
+                ctx,
+                name,
+                size,
+                vk::BufferUsageFlags::STORAGE_BUFFER | extra,
+                MemoryLocation::GpuOnly,
+            )
+            .map(Arc::new)
+        };
+        let mut transform: Vec<f32> = rotation_matrix(rotation_deg).to_vec();
+        transform.push(intensity);
+        Ok(Self {
+            partials: storage(
+                "sh partials",
+                rows as u64 * 27 * 4,
+                vk::BufferUsageFlags::empty(),
+            )?,
+            transform: upload_buffer(
+                ctx,
+                "sh transform",
+                bytemuck::cast_slice(&transform),
+                Access::ComputeBufferRead,
+            )?,
+            coefficients: storage(
+                "sh coefficients",
+                9 * 16,
+                vk::BufferUsageFlags::TRANSFER_SRC,
+            )?,
+            rows,
+        })
+    }
+}
+
+impl ShPasses {
+    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+        Ok(Self {
+            project: Pipeline::compute(
+                ctx,
+                "sh_project.comp",
+                &[Binding::SampledImage, Binding::StorageBuffer],
+                0,
+            )?,
+            reduce: Pipeline::compute(
+                ctx,
+                "sh_reduce.comp",
+                &[
+                    Binding::StorageBuffer,
+                    Binding::StorageBuffer,
+                    Binding::StorageBuffer,
+                ],
+                4,
+            )?,
+            sampler,
+        })
+    }
+
+    /// Adds `sh_project` and `sh_reduce`; returns the coefficient buffer, written.
+    /// `readers`: the access the previous frame's readers used (for the first barrier).
+    pub fn passes(
+        &self,
+        g: &mut Graph,
+        env: &Arc<Image>,
+        b: &ShBuffers,
+        readers: Access,
+    ) -> BufferHandle {
+        let mut partials = g.import_buffer(
+            "sh partials",
+            Imported::Buffer(b.partials.clone()),
+            Some(Access::ComputeBufferRead),
+            None,
+        );
+        let mut coefficients = g.import_buffer(
+            "sh coefficients",
+            Imported::Buffer(b.coefficients.clone()),
+            Some(readers),
+            None,
+        );
+        let mut p = g.add_pass("sh_project");
+        let out = p.write_buffer(&mut partials, Access::ComputeBufferWrite);
+        let (pipe, env, sampler, rows) = (
+            self.project.clone(),
+            env.clone(),
+            self.sampler.clone(),
+            b.rows,
+        );
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(
+                &pipe,
+                &[
+                    Descriptor::StaticSampled(&env, &sampler),
+                    Descriptor::Storage(out),
+                ],
+            );
+            unsafe { cx.ctx.device.cmd_dispatch(cx.cmd, rows, 1, 1) };
+        });
+        let mut p = g.add_pass("sh_reduce");
+        let parts = p.read_buffer(&partials, Access::ComputeBufferRead);
+        let coeffs = p.write_buffer(&mut coefficients, Access::ComputeBufferWrite);
+        let (pipe, transform) = (self.reduce.clone(), b.transform.clone());
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            cx.push_descriptors(
+                &pipe,
+                &[
+                    Descriptor::Storage(parts),
+                    Descriptor::StaticStorage(&transform),
+                    Descriptor::Storage(coeffs),
+                ],
+            );
+            cx.push_constants(&pipe, &rows);
+            unsafe { cx.ctx.device.cmd_dispatch(cx.cmd, 1, 1, 1) };
+        });
+        coefficients
+    }
+}
+
+/// Projects `env` on the GPU (rotated, scaled); returns the coefficients and the
+/// frame report of the two passes (`dermis sh`, tests).
+pub fn project(
+    ctx: &Arc<Context>,
+    env: &EnvMap,
+    rotation_deg: f32,
+    intensity: f32,
+) -> Result<(Sh9, FrameReport)> {
+    let image = crate::render::resources::upload_env(ctx, env)?;
+    let passes = ShPasses::new(ctx, Arc::new(Sampler::clamped(ctx, false)?))?;
+    let buffers = ShBuffers::new(ctx, &image, rotation_deg, intensity)?;
+    let readback = Arc::new(Buffer::new(
+        ctx,
+        "sh readback",
+        9 * 16,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+    )?);
+    let mut g = Graph::new();
+    let coefficients = passes.passes(&mut g, &image, &buffers, Access::TransferSrc);
+    let mut out = g.import_buffer(
+        "sh readback",
+        Imported::Buffer(readback.clone()),
+        None,
+        Some(Access::HostRead),
+    );
+    let mut p = g.add_pass("readback");
+    let src = p.read_buffer(&coefficients, Access::TransferSrc);
+    let dst = p.write_buffer(&mut out, Access::TransferDst);
+    p.record(move |cx| unsafe {
+        let region = vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: 0,
+            size: 9 * 16,
+        };
+        cx.ctx
+            .device
+            .cmd_copy_buffer(cx.cmd, cx.buffer(src), cx.buffer(dst), &[region]);
+    });
+    let mut ex = Executor::new(ctx, 1)?;
+    let mut reports: Vec<FrameReport> = ex.run(g)?.into_iter().collect();
+    reports.extend(ex.finish()?);
+    let bytes = readback
+        .mapped()
+        .ok_or_else(|| Error::Graph("readback buffer is not host-visible".into()))?;
+    let v: &[f32] = bytemuck::cast_slice(bytes);
+    let coeffs = std::array::from_fn(|i| Vec3::new(v[4 * i], v[4 * i + 1], v[4 * i + 2]));
+    Ok((coeffs, reports.pop().unwrap_or_default()))
+}
