@@ -15,6 +15,10 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_tangent;
+layout(location = 4) in vec3 v_t012;
+layout(location = 5) in vec3 v_t345;
+layout(location = 6) in vec3 v_t678;
+#include "lighting.glsl"
 layout(location = 0) out vec4 color;
 
 vec3 shading_normal() {
@@ -28,10 +32,7 @@ vec3 shading_normal() {
 
 void main() {
     vec3 n = shading_normal();
-    vec3 e = max(sh_irradiance(lighting.sh, n), vec3(0.0));
-    for (int i = 0; i < int(frame.env.z); ++i) {
-        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
-    }
+    vec3 e = irradiance_at(n);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     color = vec4(albedo / PI_F * e, 1.0);
 }

@@ -15,6 +15,10 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_tangent;
+layout(location = 4) in vec3 v_t012;
+layout(location = 5) in vec3 v_t345;
+layout(location = 6) in vec3 v_t678;
+#include "lighting.glsl"
 layout(location = 0) out vec4 irradiance;
 
 void main() {
@@ -23,10 +27,7 @@ void main() {
     vec3 b = cross(n, t) * v_tangent.w;
     vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
     n = normalize(m.x * t + m.y * b + m.z * n);
-    vec3 e = max(sh_irradiance(lighting.sh, n), vec3(0.0));
-    for (int i = 0; i < int(frame.env.z); ++i) {
-        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
-    }
+    vec3 e = irradiance_at(n);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
 }

@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{load_scene, SceneFile};
+use dermis::scene::file::{load_scene, Occlusion, SceneFile};
 use dermis::scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,6 +50,20 @@ enum Command {
         #[arg(long)]
         timings: bool,
     },
+    /// Compute (and cache) the per-vertex occlusion transfer ahead of rendering.
+    Precompute {
+        /// TOML scene file; its mesh and `skin.occlusion` are used.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// glTF mesh, replacing the scene's.
+        #[arg(long)]
+        mesh: Option<PathBuf>,
+        #[arg(long)]
+        mm_per_unit: Option<f32>,
+        /// raytrace (default) or off.
+        #[arg(long, value_parser = parse_occlusion)]
+        occlusion: Option<Occlusion>,
+    },
     /// Render the scene to an image (the built-in head under the sky by default).
     Render {
         /// TOML scene file (see docs/scene-format.md).
@@ -77,6 +91,9 @@ enum Command {
         /// Side of the UV-space irradiance texture (power of two, 256..8192).
         #[arg(long)]
         irradiance_res: Option<u32>,
+        /// Per-vertex occlusion: raytrace, off (raster: not implemented yet).
+        #[arg(long, value_parser = parse_occlusion)]
+        occlusion: Option<Occlusion>,
         #[arg(long)]
         width: Option<u32>,
         #[arg(long)]
@@ -97,6 +114,15 @@ enum Command {
         #[arg(long)]
         dump_graph: bool,
     },
+}
+
+fn parse_occlusion(s: &str) -> Result<Occlusion, String> {
+    match s {
+        "raster" => Ok(Occlusion::Raster),
+        "raytrace" => Ok(Occlusion::Raytrace),
+        "off" => Ok(Occlusion::Off),
+        _ => Err(format!("{s:?}: expected raster, raytrace or off")),
+    }
 }
 
 fn main() -> ExitCode {
@@ -154,6 +180,37 @@ fn run(cli: Cli) -> dermis::Result<()> {
             }
             Ok(())
         }
+        Command::Precompute {
+            scene,
+            mesh,
+            mm_per_unit,
+            occlusion,
+        } => {
+            let file = match &scene {
+                Some(path) => load_scene(path)?,
+                None => SceneFile::default(),
+            };
+            let file = Overrides {
+                mesh,
+                mm_per_unit,
+                occlusion,
+                ..Overrides::default()
+            }
+            .apply(file)?;
+            let mesh = dermis::scene::load_mesh(&file)?;
+            let started = std::time::Instant::now();
+            let (t, on) = dermis::scene::transfer_for(&mesh, file.skin.occlusion)?;
+            let secs = started.elapsed().as_secs_f64();
+            println!(
+                "{} vertices, occlusion {}: {:.2} s ({:.1} µs per vertex), cache {}",
+                t.coeffs.len(),
+                if on { "raytrace" } else { "off" },
+                secs,
+                secs * 1e6 / t.coeffs.len().max(1) as f64,
+                dermis::light::occlusion::default_cache_dir().display()
+            );
+            Ok(())
+        }
         Command::Sh {
             env,
             rotate,
@@ -195,6 +252,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             env_rotate,
             exposure,
             irradiance_res,
+            occlusion,
             width,
             height,
             view,
@@ -214,6 +272,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 env_rotate_deg: env_rotate,
                 exposure,
                 irradiance_resolution: irradiance_res,
+                occlusion,
                 width,
                 height,
             };

@@ -267,3 +267,80 @@ fn texture_space_diffusion_leaves_no_seam_lines() {
         seam_gradients(load_scene(&path).unwrap(), 450.0),
     );
 }
+
+/// Mean red irradiance per face region of the built-in head (UV-space view),
+/// under a uniform red environment (the paper's Fig. 6).
+fn region_irradiance(occlusion: dermis::scene::file::Occlusion) -> [f32; 10] {
+    use dermis::render::View;
+    let mut file = SceneFile::default();
+    file.environment.source = "uniform:1,0,0".into();
+    file.skin.occlusion = occlusion;
+    file.render.irradiance_resolution = 512;
+    file.render.width = 64;
+    file.render.height = 64;
+    let scene = Scene::load(file).unwrap();
+    let out = common::with_gpu(|ctx| {
+        let opts = RenderOptions {
+            view: View::Irradiance,
+            ..RenderOptions::default()
+        };
+        render_scene(ctx, &scene, &opts).unwrap()
+    });
+    let irr = out.hdr.unwrap();
+    let (n, regions) = (out.width as usize, &scene.regions);
+    let (mut sum, mut count) = ([0.0f64; 10], [0usize; 10]);
+    for y in 0..n {
+        for x in 0..n {
+            let p = &irr[(y * n + x) * 4..][..4];
+            if p[3] < 0.999 {
+                continue;
+            }
+            let (rx, ry) = (
+                x * regions.width as usize / n,
+                y * regions.height as usize / n,
+            );
+            let id = regions.rgba8[(ry * regions.width as usize + rx) * 4] as usize;
+            if id < 10 {
+                sum[id] += (p[0] / p[3]) as f64;
+                count[id] += 1;
+            }
+        }
+    }
+    std::array::from_fn(|i| (sum[i] / count[i].max(1) as f64) as f32)
+}
+
+#[test]
+fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
+    use dermis::scene::file::Occlusion;
+    use dermis::scene::head::{
+        REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES, REGION_NOSE,
+    };
+    let on = region_irradiance(Occlusion::Raytrace);
+    let off = region_irradiance(Occlusion::Off);
+    for i in 0..10 {
+        println!(
+            "{:<14} on {:.3} off {:.3} ratio {:.3}",
+            REGION_NAMES[i],
+            on[i],
+            off[i],
+            on[i] / off[i]
+        );
+    }
+    let ratio = |r: u8| on[r as usize] / off[r as usize];
+    // Without occlusion a uniform sky gives E = π·L everywhere (the albedo^mix aside).
+    assert!(
+        ratio(REGION_EYES) < 0.8,
+        "eye sockets: {}",
+        ratio(REGION_EYES)
+    );
+    assert!(ratio(REGION_EARS) < 0.85, "ears: {}", ratio(REGION_EARS));
+    assert!(
+        ratio(REGION_NOSE) < 0.95,
+        "nose (nostrils): {}",
+        ratio(REGION_NOSE)
+    );
+    assert!(
+        ratio(REGION_FOREHEAD) > ratio(REGION_EYES) + 0.1,
+        "the open forehead stays brighter"
+    );
+}

@@ -5,6 +5,6 @@ layout(std140, binding = 0) uniform Frame {
     vec4 camera_pos;        // xyz mm
     vec4 light_dir[4];      // xyz: direction towards the light
     vec4 light_color[4];    // rgb: irradiance on a surface facing it
-    vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count
+    vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on
     vec4 params;            // x: exposure (EV)
 } frame;

@@ -33,6 +33,8 @@ pub enum Access {
     ComputeBufferWrite,
     /// Storage buffer read in a fragment shader.
     FragmentBufferRead,
+    /// Storage buffer read in any shader stage: how static data buffers are left.
+    ShaderBufferRead,
     VertexBuffer,
     IndexBuffer,
     /// Uniform buffer read by any shader stage.
@@ -129,6 +131,12 @@ impl Access {
                 L::UNDEFINED,
                 true,
             ),
+            Access::ShaderBufferRead => (
+                S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                A::SHADER_STORAGE_READ,
+                L::UNDEFINED,
+                false,
+            ),
             Access::FragmentBufferRead => (
                 S::FRAGMENT_SHADER,
                 A::SHADER_STORAGE_READ,
@@ -165,6 +173,7 @@ impl Access {
             Access::ComputeBufferRead
                 | Access::ComputeBufferWrite
                 | Access::FragmentBufferRead
+                | Access::ShaderBufferRead
                 | Access::VertexBuffer
                 | Access::IndexBuffer
                 | Access::UniformRead
@@ -198,9 +207,10 @@ impl Access {
     pub fn buffer_usage(self) -> vk::BufferUsageFlags {
         use vk::BufferUsageFlags as U;
         match self {
-            Access::ComputeBufferRead | Access::ComputeBufferWrite | Access::FragmentBufferRead => {
-                U::STORAGE_BUFFER
-            }
+            Access::ComputeBufferRead
+            | Access::ComputeBufferWrite
+            | Access::FragmentBufferRead
+            | Access::ShaderBufferRead => U::STORAGE_BUFFER,
             Access::VertexBuffer => U::VERTEX_BUFFER,
             Access::IndexBuffer => U::INDEX_BUFFER,
             Access::UniformRead => U::UNIFORM_BUFFER,

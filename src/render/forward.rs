@@ -31,7 +31,10 @@ pub const MAX_LIGHTS: usize = 4;
 
 pub struct ForwardPipelines {
     background: Arc<Pipeline>,
-    mesh: Arc<Pipeline>,
+    /// Direct diffuse shading (`--view direct`).
+    pub direct: Arc<Pipeline>,
+    /// The transfer's DC term (`--view occlusion`).
+    pub occlusion: Arc<Pipeline>,
 }
 
 impl ForwardPipelines {
@@ -49,26 +52,33 @@ impl ForwardPipelines {
                 cull_mode: vk::CullModeFlags::NONE,
             },
         )?;
-        let mesh = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex: "mesh.vert",
-                fragment: "forward.frag",
-                bindings: &[
-                    Binding::UniformBuffer,
-                    Binding::SampledImage,
-                    Binding::SampledImage,
-                    Binding::StorageBuffer,
-                ],
-                push_constant_bytes: 0,
-                color_formats: &[HDR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
-                // Scanned meshes are not reliably closed or consistently wound.
-                cull_mode: vk::CullModeFlags::NONE,
-            },
-        )?;
-        Ok(Self { background, mesh })
+        let lit = |fragment| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    vertex: "mesh_lit.vert",
+                    fragment,
+                    bindings: &[
+                        Binding::UniformBuffer,
+                        Binding::SampledImage,
+                        Binding::SampledImage,
+                        Binding::StorageBuffer,
+                        Binding::StorageBuffer,
+                    ],
+                    push_constant_bytes: 0,
+                    color_formats: &[HDR_FORMAT],
+                    depth_format: Some(DEPTH_FORMAT),
+                    vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+                    // Scanned meshes are not reliably closed or consistently wound.
+                    cull_mode: vk::CullModeFlags::NONE,
+                },
+            )
+        };
+        Ok(Self {
+            background,
+            direct: lit("forward.frag")?,
+            occlusion: lit("occlusion.frag")?,
+        })
     }
 }
 
@@ -78,6 +88,8 @@ pub struct ForwardInputs {
     pub mesh: Arc<MeshBuffers>,
     pub albedo: Arc<Image>,
     pub normal: Arc<Image>,
+    /// Per-vertex SH transfer, 9 floats per vertex (light::occlusion).
+    pub transfer: Arc<Buffer>,
     /// Specular intensity, roughness and face-region maps (read by the specular term).
     pub specular: Arc<Image>,
     pub roughness: Arc<Image>,
@@ -113,22 +125,23 @@ pub fn background(
     });
 }
 
-/// The mesh with direct diffuse shading (no scattering) over `hdr`; `sh`: the
-/// environment's coefficients (light::sh_pass).
+/// The mesh drawn in screen space over `hdr` with `pipeline` (`direct` or
+/// `occlusion` of [`ForwardPipelines`]); `sh`: the environment's coefficients.
 pub fn direct(
     g: &mut Graph,
-    p: &ForwardPipelines,
+    pipeline: &Arc<Pipeline>,
+    name: &str,
     inputs: &Arc<ForwardInputs>,
     sh: &BufferHandle,
     hdr: &mut ImageHandle,
 ) {
     let (w, h) = (hdr.desc.width, hdr.desc.height);
     let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
-    let mut pass = g.add_pass("direct");
+    let mut pass = g.add_pass(name);
     let coeffs = pass.read_buffer(sh, Access::FragmentBufferRead);
     pass.color_attachment(hdr, LoadOp::Load);
     pass.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
-    let (pipe, inp) = (p.mesh.clone(), inputs.clone());
+    let (pipe, inp) = (pipeline.clone(), inputs.clone());
     pass.record(move |cx| {
         cx.bind(&pipe);
         cx.push_descriptors(
@@ -138,6 +151,7 @@ pub fn direct(
                 Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
                 Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
                 Descriptor::Storage(coeffs),
+                Descriptor::StaticStorage(&inp.transfer),
             ],
         );
         cx.bind_vertex_buffer(&inp.mesh.vertices);

@@ -35,6 +35,8 @@ pub enum View {
     Diffuse,
     /// Direct diffuse shading in screen space, no scattering (for comparison).
     Direct,
+    /// The per-vertex transfer's DC term relative to open sky (1 = unoccluded).
+    Occlusion,
     /// UV-space irradiance (coverage-premultiplied, as stored).
     Irradiance,
     /// UV-space stretch map (texels per mm in R and G; alpha = coverage).
@@ -49,13 +51,14 @@ impl View {
             "final" => View::Final,
             "diffuse" => View::Diffuse,
             "direct" => View::Direct,
+            "occlusion" => View::Occlusion,
             "irradiance" => View::Irradiance,
             "stretch" => View::Stretch,
             _ => match s.strip_prefix("blur").and_then(|k| k.parse::<u8>().ok()) {
                 Some(k @ 1..=6) => View::Blur(k),
                 _ => {
                     return Err(Error::Input(format!(
-                    "unknown view {s:?}: final, diffuse, direct, irradiance, stretch, blur1..blur6"
+                    "unknown view {s:?}: final, diffuse, direct, occlusion, irradiance, stretch, blur1..blur6"
                 )))
                 }
             },
@@ -133,7 +136,12 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
         camera_pos: scene.camera.position.extend(1.0).into(),
         light_dir: [[0.0; 4]; MAX_LIGHTS],
         light_color: [[0.0; 4]; MAX_LIGHTS],
-        env: [env.rotation_deg.to_radians(), env.intensity, 0.0, 0.0],
+        env: [
+            env.rotation_deg.to_radians(),
+            env.intensity,
+            0.0,
+            if scene.occlusion { 1.0 } else { 0.0 },
+        ],
         params: [scene.exposure(), 0.0, 0.0, 0.0],
     };
     if scene.lights.len() > MAX_LIGHTS {
@@ -181,6 +189,12 @@ impl Frame {
             mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
             albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
             normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
+            transfer: upload_buffer(
+                ctx,
+                "transfer",
+                bytemuck::cast_slice(&scene.transfer.coeffs),
+                Access::ShaderBufferRead,
+            )?,
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
             roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
             regions: upload_rgba8(ctx, "region map", &scene.regions)?,
@@ -220,6 +234,15 @@ impl Frame {
         })
     }
 
+    /// The occlusion view shows a ratio in [0, 1]: no exposure.
+    fn exposure_for(&self, view: View) -> f32 {
+        if view == View::Occlusion {
+            0.0
+        } else {
+            self.exposure
+        }
+    }
+
     /// Builds the frame graph; returns the image to read back (and its size)
     /// for `view`, and for screen views the tone-mapped 8-bit image.
     fn graph(
@@ -235,9 +258,13 @@ impl Frame {
             &self.sh_buffers,
             Access::FragmentBufferRead,
         );
-        if view == View::Direct {
+        if let View::Direct | View::Occlusion = view {
+            let (pipeline, name) = match view {
+                View::Direct => (&self.forward.direct, "direct"),
+                _ => (&self.forward.occlusion, "occlusion"),
+            };
             forward::background(g, &self.forward, &self.inputs, &mut hdr);
-            forward::direct(g, &self.forward, &self.inputs, &sh, &mut hdr);
+            forward::direct(g, pipeline, name, &self.inputs, &sh, &mut hdr);
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
@@ -277,7 +304,8 @@ impl Frame {
             );
         }
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
-        self.tonemap.pass(g, &hdr, &mut ldr, self.exposure);
+        self.tonemap
+            .pass(g, &hdr, &mut ldr, self.exposure_for(view));
         (hdr, Some(ldr))
     }
 }
@@ -346,7 +374,7 @@ pub fn render_scene(
             .map(<[u8]>::to_vec)
             .ok_or_else(|| Error::Graph("readback buffer is not host-visible".into()))
     };
-    let exposure = frame.exposure;
+    let exposure = frame.exposure_for(opts.view);
     // Screen views: linear radiance × 2^exposure. UV views: the values as stored.
     let hdr = match &hdr_readback {
         Some(b) => {

@@ -326,7 +326,7 @@ impl Default for Skin {
             kernel: Kernel::Deon7,
             profile: default_profile(),
             regions: default_regions(),
-            occlusion: Occlusion::Raster,
+            occlusion: Occlusion::Raytrace,
             stretch_correction: true,
         }
     }

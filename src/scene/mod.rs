@@ -10,8 +10,9 @@ pub mod texture;
 
 use crate::error::Result;
 use crate::light::envmap::{self, EnvMap};
+use crate::light::occlusion::{self, RayOptions, Transfer};
 use camera::Camera;
-use file::{LightKind, SceneFile};
+use file::{LightKind, Occlusion, SceneFile};
 use glam::Vec3;
 use mesh::Mesh;
 use std::path::PathBuf;
@@ -30,6 +31,7 @@ pub struct Overrides {
     pub env_rotate_deg: Option<f32>,
     pub exposure: Option<f32>,
     pub irradiance_resolution: Option<u32>,
+    pub occlusion: Option<Occlusion>,
     pub width: Option<u32>,
     pub height: Option<u32>,
 }
@@ -50,6 +52,7 @@ impl Overrides {
         file.render.irradiance_resolution = self
             .irradiance_resolution
             .unwrap_or(file.render.irradiance_resolution);
+        file.skin.occlusion = self.occlusion.unwrap_or(file.skin.occlusion);
         file.render.width = self.width.unwrap_or(file.render.width);
         file.render.height = self.height.unwrap_or(file.render.height);
         file.validate()
@@ -76,6 +79,10 @@ pub struct Scene {
     pub roughness: Texture,
     pub regions: Texture,
     pub env: EnvMap,
+    /// Per-vertex SH visibility transfer (unoccluded when occlusion is off).
+    pub transfer: Transfer,
+    /// Whether the frame lights through `transfer` (else R&H at the normal).
+    pub occlusion: bool,
     pub camera: Camera,
     pub lights: Vec<DirectionalLight>,
     /// The settings it was loaded from (skin, render, environment rotation and intensity).
@@ -138,6 +145,7 @@ impl Scene {
                 report.negative
             );
         }
+        let (transfer, occlusion) = transfer_for(&mesh, file.skin.occlusion)?;
         let bounds = mesh
             .bounds()
             .ok_or_else(|| crate::Error::Input("the mesh is empty".into()))?;
@@ -177,6 +185,8 @@ impl Scene {
             roughness,
             regions,
             env,
+            transfer,
+            occlusion,
             camera,
             lights,
             file,
@@ -199,6 +209,44 @@ impl Scene {
                 0.0
             }
         })
+    }
+}
+
+/// The scene's mesh alone: its glTF file, or the built-in head.
+pub fn load_mesh(file: &SceneFile) -> Result<Mesh> {
+    Ok(match &file.mesh {
+        Some(path) => gltf::load_mesh(path, file.mm_per_unit)?,
+        None => head::build_head(&head::HeadParams::default()).mesh,
+    })
+}
+
+/// The per-vertex transfer for `mode`, from the disk cache when it holds it.
+pub fn transfer_for(mesh: &Mesh, mode: Occlusion) -> Result<(Transfer, bool)> {
+    match mode {
+        Occlusion::Off => Ok((occlusion::unoccluded(mesh), false)),
+        Occlusion::Raster => Err(crate::Error::Input(
+            "skin.occlusion = \"raster\": the GPU cube-map method is not implemented yet; use \"raytrace\" or \"off\"".into(),
+        )),
+        Occlusion::Raytrace => {
+            let opts = RayOptions::default();
+            let key = occlusion::cache_key(mesh, "raytrace", &opts.cache_settings());
+            let dir = occlusion::default_cache_dir();
+            if let Some(t) = occlusion::load_cached(&dir, &key) {
+                log::info!("occlusion: cached transfer {key} from {}", dir.display());
+                return Ok((t, true));
+            }
+            let started = std::time::Instant::now();
+            let t = occlusion::raytrace(mesh, &opts, true);
+            log::info!(
+                "occlusion: ray-cast {} vertices in {:.2} s",
+                mesh.vertex_count(),
+                started.elapsed().as_secs_f64()
+            );
+            if let Err(e) = occlusion::store_cached(&dir, &key, &t) {
+                log::warn!("occlusion: cannot cache in {}: {e}", dir.display());
+            }
+            Ok((t, true))
+        }
     }
 }
 

@@ -17,11 +17,13 @@ impl IrradiancePass {
         Ok(Self {
             pipeline: uv_pipeline(
                 ctx,
+                "uv_lit.vert",
                 "irradiance.frag",
                 &[
                     Binding::UniformBuffer,
                     Binding::SampledImage,
                     Binding::SampledImage,
+                    Binding::StorageBuffer,
                     Binding::StorageBuffer,
                 ],
                 4,
@@ -55,6 +57,7 @@ impl IrradiancePass {
                     Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
                     Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
                     Descriptor::Storage(coeffs),
+                    Descriptor::StaticStorage(&inp.transfer),
                 ],
             );
             cx.push_constants(&pipe, &mix);

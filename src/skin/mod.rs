@@ -84,6 +84,7 @@ pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
 /// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.
 pub(crate) fn uv_pipeline(
     ctx: &Arc<Context>,
+    vertex: &str,
     fragment: &str,
     bindings: &[Binding],
     push_constant_bytes: u32,
@@ -91,7 +92,7 @@ pub(crate) fn uv_pipeline(
     Pipeline::graphics(
         ctx,
         &GraphicsDesc {
-            vertex: "uv.vert",
+            vertex,
             fragment,
             bindings,
             push_constant_bytes,

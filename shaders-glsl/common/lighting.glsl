@@ -1,0 +1,20 @@
+// Diffuse irradiance at a surface point: the environment through SH — with
+// occlusion, E = Σ L_i·T_i from the interpolated per-vertex transfer (the paper's
+// eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
+// directional lights. Needs frame.glsl, sh.glsl, the Lighting buffer and v_t*.
+vec3 irradiance_at(vec3 n) {
+    vec3 e;
+    if (frame.env.w > 0.5) {
+        float t[9] = float[9](v_t012.x, v_t012.y, v_t012.z, v_t345.x, v_t345.y, v_t345.z,
+                              v_t678.x, v_t678.y, v_t678.z);
+        e = vec3(0.0);
+        for (int i = 0; i < 9; ++i) e += lighting.sh[i].rgb * t[i];
+    } else {
+        e = sh_irradiance(lighting.sh, n);
+    }
+    e = max(e, vec3(0.0));
+    for (int i = 0; i < int(frame.env.z); ++i) {
+        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
+    }
+    return e;
+}

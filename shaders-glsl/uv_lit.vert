@@ -1,0 +1,24 @@
+#version 460
+// uv.vert plus the vertex's SH transfer, for the irradiance pass.
+#extension GL_GOOGLE_include_directive : require
+#include "transfer.glsl"
+layout(location = 0) in vec3 position;   // mm
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec2 uv;
+layout(location = 3) in vec4 tangent;
+layout(location = 0) out vec3 v_position;
+layout(location = 1) out vec3 v_normal;
+layout(location = 2) out vec2 v_uv;
+layout(location = 3) out vec4 v_tangent;
+layout(location = 4) out vec3 v_t012;
+layout(location = 5) out vec3 v_t345;
+layout(location = 6) out vec3 v_t678;
+
+void main() {
+    v_position = position;
+    v_normal = normal;
+    v_uv = uv;
+    v_tangent = tangent;
+    load_transfer(v_t012, v_t345, v_t678);
+    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+}
