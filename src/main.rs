@@ -60,7 +60,7 @@ enum Command {
         mesh: Option<PathBuf>,
         #[arg(long)]
         mm_per_unit: Option<f32>,
-        /// raytrace (default) or off.
+        /// raster (the paper's cube maps), raytrace (default) or off.
         #[arg(long, value_parser = parse_occlusion)]
         occlusion: Option<Occlusion>,
     },
@@ -91,7 +91,7 @@ enum Command {
         /// Side of the UV-space irradiance texture (power of two, 256..8192).
         #[arg(long)]
         irradiance_res: Option<u32>,
-        /// Per-vertex occlusion: raytrace, off (raster: not implemented yet).
+        /// Per-vertex occlusion: raster (the paper's cube maps), raytrace, off.
         #[arg(long, value_parser = parse_occlusion)]
         occlusion: Option<Occlusion>,
         #[arg(long)]
@@ -198,13 +198,14 @@ fn run(cli: Cli) -> dermis::Result<()> {
             }
             .apply(file)?;
             let mesh = dermis::scene::load_mesh(&file)?;
+            let ctx = Context::new(&context)?;
             let started = std::time::Instant::now();
-            let (t, on) = dermis::scene::transfer_for(&mesh, file.skin.occlusion)?;
+            let t = dermis::light::transfer_for(&ctx, &mesh, file.skin.occlusion)?;
             let secs = started.elapsed().as_secs_f64();
             println!(
-                "{} vertices, occlusion {}: {:.2} s ({:.1} µs per vertex), cache {}",
+                "{} vertices, occlusion {:?}: {:.2} s ({:.1} µs per vertex), cache {}",
                 t.coeffs.len(),
-                if on { "raytrace" } else { "off" },
+                file.skin.occlusion,
                 secs,
                 secs * 1e6 / t.coeffs.len().max(1) as f64,
                 dermis::light::occlusion::default_cache_dir().display()

@@ -344,3 +344,36 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
         "the open forehead stays brighter"
     );
 }
+
+#[test]
+fn raster_and_raytraced_occlusion_agree_on_the_scan() {
+    use dermis::light::occlusion::{raytrace, RayOptions};
+    use dermis::light::occlusion_raster::{raster_vertices, RasterOptions};
+    let Some(dir) = assets() else { return };
+    let mesh = dermis::scene::gltf::load_mesh(
+        &dir.join("head/lee-perry-smith/LeePerrySmith.glb"),
+        Some(50.3),
+    )
+    .unwrap();
+    // Every 8th vertex: a 1,160-vertex sample of the whole head.
+    let sample: Vec<u32> = (0..mesh.vertex_count() as u32).step_by(8).collect();
+    let cpu = raytrace(&mesh, &RayOptions::default(), false);
+    let gpu = common::with_gpu(|ctx| {
+        raster_vertices(ctx, &mesh, &sample, &RasterOptions::default(), false).unwrap()
+    });
+    let dc_cpu: Vec<f32> = sample.iter().map(|&v| cpu.coeffs[v as usize][0]).collect();
+    let dc_gpu: Vec<f32> = gpu.coeffs.iter().map(|t| t[0]).collect();
+    let mean = dc_cpu.iter().sum::<f32>() / dc_cpu.len() as f32;
+    let mad = dc_cpu
+        .iter()
+        .zip(&dc_gpu)
+        .map(|(a, b)| (a - b).abs())
+        .sum::<f32>()
+        / dc_cpu.len() as f32;
+    println!(
+        "{} vertices: mean DC {mean:.4}, mean |raster - raytrace| {mad:.5} ({:.2} % of the mean)",
+        sample.len(),
+        100.0 * mad / mean
+    );
+    assert!(mad < 0.02 * mean, "methods disagree: {mad} vs mean {mean}");
+}

@@ -193,6 +193,29 @@ impl PassCx<'_> {
         };
     }
 
+    /// Restricts drawing to a rectangle of the attachment (viewport and scissor).
+    pub fn set_viewport(&self, x: u32, y: u32, width: u32, height: u32) {
+        let viewport = vk::Viewport {
+            x: x as f32,
+            y: y as f32,
+            width: width as f32,
+            height: height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let scissor = vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x as i32,
+                y: y as i32,
+            },
+            extent: vk::Extent2D { width, height },
+        };
+        unsafe {
+            self.device().cmd_set_viewport(self.cmd, 0, &[viewport]);
+            self.device().cmd_set_scissor(self.cmd, 0, &[scissor]);
+        }
+    }
+
     pub fn draw(&self, vertices: u32, instances: u32) {
         unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
     }

@@ -13,7 +13,7 @@ use crate::graph::{Access, Executor, Graph};
 use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::profile::RunReport;
-use crate::scene::file::SceneFile;
+use crate::scene::file::{Occlusion, SceneFile};
 use crate::scene::Scene;
 use crate::skin::blur::BlurChain;
 use crate::skin::irradiance::IrradiancePass;
@@ -140,7 +140,11 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
             env.rotation_deg.to_radians(),
             env.intensity,
             0.0,
-            if scene.occlusion { 1.0 } else { 0.0 },
+            if scene.file.skin.occlusion == Occlusion::Off {
+                0.0
+            } else {
+                1.0
+            },
         ],
         params: [scene.exposure(), 0.0, 0.0, 0.0],
     };
@@ -192,7 +196,10 @@ impl Frame {
             transfer: upload_buffer(
                 ctx,
                 "transfer",
-                bytemuck::cast_slice(&scene.transfer.coeffs),
+                bytemuck::cast_slice(
+                    &crate::light::transfer_for(ctx, &scene.mesh, scene.file.skin.occlusion)?
+                        .coeffs,
+                ),
                 Access::ShaderBufferRead,
             )?,
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,

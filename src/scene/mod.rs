@@ -10,7 +10,6 @@ pub mod texture;
 
 use crate::error::Result;
 use crate::light::envmap::{self, EnvMap};
-use crate::light::occlusion::{self, RayOptions, Transfer};
 use camera::Camera;
 use file::{LightKind, Occlusion, SceneFile};
 use glam::Vec3;
@@ -79,10 +78,6 @@ pub struct Scene {
     pub roughness: Texture,
     pub regions: Texture,
     pub env: EnvMap,
-    /// Per-vertex SH visibility transfer (unoccluded when occlusion is off).
-    pub transfer: Transfer,
-    /// Whether the frame lights through `transfer` (else R&H at the normal).
-    pub occlusion: bool,
     pub camera: Camera,
     pub lights: Vec<DirectionalLight>,
     /// The settings it was loaded from (skin, render, environment rotation and intensity).
@@ -145,7 +140,6 @@ impl Scene {
                 report.negative
             );
         }
-        let (transfer, occlusion) = transfer_for(&mesh, file.skin.occlusion)?;
         let bounds = mesh
             .bounds()
             .ok_or_else(|| crate::Error::Input("the mesh is empty".into()))?;
@@ -185,8 +179,6 @@ impl Scene {
             roughness,
             regions,
             env,
-            transfer,
-            occlusion,
             camera,
             lights,
             file,
@@ -218,36 +210,6 @@ pub fn load_mesh(file: &SceneFile) -> Result<Mesh> {
         Some(path) => gltf::load_mesh(path, file.mm_per_unit)?,
         None => head::build_head(&head::HeadParams::default()).mesh,
     })
-}
-
-/// The per-vertex transfer for `mode`, from the disk cache when it holds it.
-pub fn transfer_for(mesh: &Mesh, mode: Occlusion) -> Result<(Transfer, bool)> {
-    match mode {
-        Occlusion::Off => Ok((occlusion::unoccluded(mesh), false)),
-        Occlusion::Raster => Err(crate::Error::Input(
-            "skin.occlusion = \"raster\": the GPU cube-map method is not implemented yet; use \"raytrace\" or \"off\"".into(),
-        )),
-        Occlusion::Raytrace => {
-            let opts = RayOptions::default();
-            let key = occlusion::cache_key(mesh, "raytrace", &opts.cache_settings());
-            let dir = occlusion::default_cache_dir();
-            if let Some(t) = occlusion::load_cached(&dir, &key) {
-                log::info!("occlusion: cached transfer {key} from {}", dir.display());
-                return Ok((t, true));
-            }
-            let started = std::time::Instant::now();
-            let t = occlusion::raytrace(mesh, &opts, true);
-            log::info!(
-                "occlusion: ray-cast {} vertices in {:.2} s",
-                mesh.vertex_count(),
-                started.elapsed().as_secs_f64()
-            );
-            if let Err(e) = occlusion::store_cached(&dir, &key, &t) {
-                log::warn!("occlusion: cannot cache in {}: {e}", dir.display());
-            }
-            Ok((t, true))
-        }
-    }
 }
 
 /// The scene's camera; with neither a position nor an orbit given, it frames the
