@@ -377,3 +377,61 @@ fn raster_and_raytraced_occlusion_agree_on_the_scan() {
     );
     assert!(mad < 0.02 * mean, "methods disagree: {mad} vs mean {mean}");
 }
+
+#[test]
+fn scattering_bleeds_red_into_the_shadow_edge() {
+    use dermis::render::View;
+    use dermis::scene::file::{Light, LightKind, Occlusion};
+    let mut file = SceneFile::default();
+    file.environment.source = "uniform:0,0,0".into();
+    file.skin.occlusion = Occlusion::Off;
+    file.lights = vec![Light {
+        kind: LightKind::Directional,
+        direction: Some([1.0, 0.0, -0.3]),
+        position: None,
+        color: [1.0, 1.0, 1.0],
+        intensity: 3.0,
+        shadow: false,
+    }];
+    file.render.width = 256;
+    file.render.height = 256;
+    file.render.irradiance_resolution = 1024;
+    file.render.exposure = Some(0.0);
+    let scene = Scene::load(file).unwrap();
+    let [direct, skin] = [View::Direct, View::Final].map(|view| {
+        common::with_gpu(|ctx| {
+            let opts = RenderOptions {
+                view,
+                hdr: true,
+                ..RenderOptions::default()
+            };
+            render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()
+        })
+    });
+    let luma = |p: &[f32]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let max = direct.chunks_exact(4).map(luma).fold(0.0f32, f32::max);
+    let smax = skin.chunks_exact(4).map(luma).fold(0.0f32, f32::max);
+    // Lit skin (direct above 30 % of its peak) against the shadow edge: pixels the
+    // direct shading leaves black (< 0.5 %) that scattering lights (> 0.5 %).
+    let (mut lit, mut edge) = ((0.0f64, 0usize), (0.0f64, 0usize));
+    for (d, s) in direct.chunks_exact(4).zip(skin.chunks_exact(4)) {
+        let rg = (s[0] / s[1].max(1e-6)) as f64;
+        if luma(d) > 0.3 * max {
+            lit = (lit.0 + rg, lit.1 + 1);
+        } else if luma(d) < 0.005 * max && luma(s) > 0.005 * smax {
+            edge = (edge.0 + rg, edge.1 + 1);
+        }
+    }
+    let (rl, re) = (lit.0 / lit.1.max(1) as f64, edge.0 / edge.1.max(1) as f64);
+    println!(
+        "red/green of the scattered image: lit skin {rl:.3} ({} px), shadow edge {re:.3} ({} px)",
+        lit.1, edge.1
+    );
+    assert!(
+        lit.1 > 100 && edge.1 > 50,
+        "too few pixels: {} lit, {} edge",
+        lit.1,
+        edge.1
+    );
+    assert!(re > 1.3 * rl, "no red bleeding: {re} vs {rl}");
+}

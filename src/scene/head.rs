@@ -33,7 +33,6 @@ use glam::{Vec2, Vec3, Vec4};
 
 use super::mesh::Mesh;
 
-static T0: OnceLock<std::time::Instant> = OnceLock::new();
 /// Settings of the built-in head.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeadParams {
@@ -134,25 +133,16 @@ pub fn build_head(params: &HeadParams) -> BuiltinHead {
     let size = params.texture_size.clamp(64, 8192);
 
     let t0 = std::time::Instant::now();
-    let _ = T0.set(t0);
     let (positions, normals, tris) = surface_nets(grid_mm);
-    eprintln!("TIMING nets {:?}", t0.elapsed());
     let charts = build_charts(&positions, &tris);
-    eprintln!("TIMING charts {:?}", t0.elapsed());
-    for (i, c) in charts.iter().enumerate() {
-        if c.tris.len() > 300 {
-            eprintln!("CHART {i} axis {} tris {}", c.axis, c.tris.len());
-        }
-    }
     let pad = (size / 128).max(5); // ≥ 8 texels between charts at 1024²
     let packed = pack_charts(&positions, &tris, &charts, size, pad);
     let mut mesh = split_mesh(&positions, &normals, &tris, &charts, &packed, size);
     mesh.tangents = compute_tangents(&mesh);
-    eprintln!("TIMING split {:?}", t0.elapsed());
     let region_of_vertex = mesh.positions.iter().map(|&p| region_at(p)).collect();
     let (albedo_srgb, normal_detail, regions) =
         bake_textures(&mesh, size, 1.0 / packed.texels_per_mm, params.seed);
-    eprintln!("TIMING bake {:?}", t0.elapsed());
+    log::debug!("built-in head built in {:?}", t0.elapsed());
     log::debug!(
         "built-in head: {} vertices, {} triangles, {} charts, {:.3} mm/texel",
         mesh.vertex_count(),
@@ -888,12 +878,6 @@ fn build_charts(pos: &[Vec3], tris: &[[u32; 3]]) -> Vec<Chart> {
             continue;
         }
         budget -= 1;
-        eprintln!(
-            "SPLIT axis {} tris {} depth {}",
-            chart.axis,
-            chart.tris.len(),
-            split_depth
-        );
         let axis = AXES[chart.axis];
         for &t in &chart.tris {
             let c = tris[t as usize].map(|i| pos[i as usize].dot(axis));
@@ -1190,7 +1174,6 @@ fn bake_textures(mesh: &Mesh, size: u32, texel_mm: f32, seed: u32) -> (Vec<u8>, 
         let uv = [t[0], t[1], t[2]].map(|i| mesh.uvs[i as usize] * size as f32);
         raster_triangle(&uv, n, n, -1e-4, |x, y, b| hit[y * n + x] = (ti as u32, b));
     }
-    eprintln!("TIMING raster {:?}", T0.get().map(|t| t.elapsed()));
     let pal = Palette::new();
     let mut texels = vec![[0u8; 12]; n * n];
     par_chunks(&mut texels, n, |y, row| {
@@ -1234,11 +1217,6 @@ fn bake_textures(mesh: &Mesh, size: u32, texel_mm: f32, seed: u32) -> (Vec<u8>, 
             ];
         }
     });
-    eprintln!(
-        "TIMING eval {:?} covered {}",
-        T0.get().map(|t| t.elapsed()),
-        hit.iter().filter(|h| h.0 != u32::MAX).count()
-    );
     dilate(
         &mut texels,
         n,
