@@ -276,3 +276,57 @@ fn views_write_intermediates() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown view"));
 }
+
+#[test]
+fn sh_prints_the_projection_of_a_constant_sky() {
+    // A constant radiance c projects to L00 = c·2√π and nothing else (Ramamoorthi & Hanrahan 2001).
+    let out = dermis(&["sh", "uniform:1,0.5,0.25", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l00: Vec<f64> = v["coefficients"]["L00"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let k = 2.0 * std::f64::consts::PI.sqrt();
+    for (got, c) in l00.iter().zip([1.0, 0.5, 0.25]) {
+        assert!((got - c * k).abs() < 1e-4 * k, "{l00:?}");
+    }
+    let l22 = v["coefficients"]["L22"][0].as_f64().unwrap();
+    assert!(l22.abs() < 1e-4, "{l22}");
+    assert_eq!(v["order"][1], "L1-1");
+}
+
+#[test]
+fn precompute_fills_the_cache_and_reports_time() {
+    let cache = tmp("cache");
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_dermis"))
+            .args(["precompute", "--occlusion", "raytrace", "--validation"])
+            .env("DERMIS_CACHE_DIR", &cache)
+            .output()
+            .unwrap()
+    };
+    let out = run();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("vertices") && stdout.contains(" s ("),
+        "{stdout}"
+    );
+    let files = std::fs::read_dir(&cache).unwrap().count();
+    assert_eq!(files, 1, "one cached transfer");
+    assert!(run().status.success(), "second run reads the cache");
+    let out = dermis(&["precompute", "--occlusion", "sideways"]);
+    assert_eq!(out.status.code(), Some(2));
+}
