@@ -154,8 +154,6 @@ pub fn direct(
                 Descriptor::StaticStorage(&inp.transfer),
             ],
         );
-        cx.bind_vertex_buffer(&inp.mesh.vertices);
-        cx.bind_index_buffer(&inp.mesh.indices);
-        cx.draw_indexed(inp.mesh.index_count, 1);
+        inp.mesh.draw(cx);
     });
 }

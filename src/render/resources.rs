@@ -65,6 +65,15 @@ impl MeshBuffers {
     }
 }
 
+impl MeshBuffers {
+    /// Binds the buffers and draws every triangle (for any pass that draws the mesh).
+    pub fn draw(&self, cx: &crate::graph::PassCx) {
+        cx.bind_vertex_buffer(&self.vertices);
+        cx.bind_index_buffer(&self.indices);
+        cx.draw_indexed(self.index_count, 1);
+    }
+}
+
 /// An RGBA8 texture with a full GPU-generated mip chain; sRGB maps get an
 /// `_SRGB` format so shaders sample linear values.
 pub fn upload_rgba8(ctx: &Arc<Context>, name: &str, t: &Texture) -> Result<Arc<Image>> {

@@ -332,19 +332,9 @@ impl Default for Skin {
     }
 }
 
-/// The six-Gaussian skin profile of d'Eon & Luebke (GPU Gems 3 ch. 14, §14.4 sum-of-
-/// Gaussians fit, as carried in ARCHITECTURE.md): variance mm², RGB weights; each
-/// channel sums to 1.
+/// The six-Gaussian skin profile (`skin::profile::SKIN_TABLE`, GPU Gems 3 §14.4).
 pub fn default_profile() -> Vec<ProfileGaussian> {
-    const TABLE: [(f32, [f32; 3]); 6] = [
-        (0.0064, [0.233, 0.455, 0.649]),
-        (0.0484, [0.100, 0.336, 0.344]),
-        (0.187, [0.118, 0.198, 0.0]),
-        (0.567, [0.113, 0.007, 0.007]),
-        (1.99, [0.358, 0.004, 0.0]),
-        (7.41, [0.078, 0.0, 0.0]),
-    ];
-    TABLE
+    crate::skin::profile::SKIN_TABLE
         .iter()
         .map(|&(variance_mm2, weights)| ProfileGaussian {
             variance_mm2,
@@ -353,14 +343,15 @@ pub fn default_profile() -> Vec<ProfileGaussian> {
         .collect()
 }
 
-/// Ten regions at d'Eon & Luebke's fallback values m = 0.3, ρs = 0.18
-/// (GPU Gems 3 §14.3, used where no measured region data exists).
+/// The ten face regions at d'Eon & Luebke's fallback m = 0.3, ρs = 0.18
+/// (`skin::specular::default_regions`; no measured table could be cited).
 pub fn default_regions() -> Vec<SpecularRegion> {
-    (0..REGION_COUNT)
-        .map(|i| SpecularRegion {
-            name: format!("region{i}"),
-            rho_s: 0.18,
-            m: 0.3,
+    crate::skin::specular::default_regions()
+        .iter()
+        .map(|r| SpecularRegion {
+            name: r.name.to_string(),
+            rho_s: r.rho_s,
+            m: r.m,
         })
         .collect()
 }

@@ -61,9 +61,7 @@ impl IrradiancePass {
                 ],
             );
             cx.push_constants(&pipe, &mix);
-            cx.bind_vertex_buffer(&inp.mesh.vertices);
-            cx.bind_index_buffer(&inp.mesh.indices);
-            cx.draw_indexed(inp.mesh.index_count, 1);
+            inp.mesh.draw(cx);
         });
         out
     }

@@ -74,9 +74,7 @@ impl ShadePass {
             d.extend(refs.iter().map(|&r| Descriptor::Sampled(r, sampler)));
             cx.push_descriptors(&pipe, &d);
             cx.push_constants(&pipe, &push);
-            cx.bind_vertex_buffer(&inp.mesh.vertices);
-            cx.bind_index_buffer(&inp.mesh.indices);
-            cx.draw_indexed(inp.mesh.index_count, 1);
+            inp.mesh.draw(cx);
         });
     }
 }

@@ -36,9 +36,7 @@ impl StretchPass {
         p.record(move |cx| {
             cx.bind(&pipe);
             cx.push_constants(&pipe, &constant);
-            cx.bind_vertex_buffer(&mesh.vertices);
-            cx.bind_index_buffer(&mesh.indices);
-            cx.draw_indexed(mesh.index_count, 1);
+            mesh.draw(cx);
         });
         out
     }
