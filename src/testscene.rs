@@ -1,9 +1,10 @@
-//! The interim scene `dermis render` draws until the face passes land: a
+//! A small graph workload for testing and measuring the render graph itself: a
 //! procedural pattern through two compute blur passes and a graphics pass.
 
 use crate::error::Result;
 use crate::gpu::{Binding, Buffer, Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
-use crate::graph::{Access, Descriptor, Graph, ImageHandle, Imported, LoadOp};
+use crate::graph::upload::readback_pass;
+use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -162,18 +163,4 @@ impl TestScene {
         self.composite(g, &blurred, &mut ldr, LoadOp::DontCare, push);
         readback_pass(g, &ldr, readback);
     }
-}
-
-/// Copies `image` into a host-visible buffer and leaves it ready for the host.
-pub fn readback_pass(g: &mut Graph, image: &ImageHandle, buffer: &Arc<Buffer>) {
-    let mut out = g.import_buffer(
-        "readback",
-        Imported::Buffer(buffer.clone()),
-        Some(Access::HostRead),
-        Some(Access::HostRead),
-    );
-    let mut p = g.add_pass("readback");
-    let src = p.read(image, Access::TransferSrc);
-    let dst = p.write_buffer(&mut out, Access::TransferDst);
-    p.record(move |cx| cx.copy_image_to_buffer(src, dst));
 }

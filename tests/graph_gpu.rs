@@ -5,8 +5,9 @@ mod common;
 
 use ash::vk;
 use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation};
+use dermis::graph::upload::readback_pass;
 use dermis::graph::{Access, Clock, Compiled, Executor, Graph, Imported, LoadOp};
-use dermis::testscene::{readback_pass, CompositePush, TestScene, HALF};
+use dermis::testscene::{CompositePush, TestScene, HALF};
 use std::sync::Arc;
 
 const W: usize = 45;

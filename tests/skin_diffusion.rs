@@ -6,6 +6,7 @@ mod common;
 
 use ash::vk;
 use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation, Sampler};
+use dermis::graph::upload::readback_pass;
 use dermis::graph::upload::upload_texture;
 use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::render::resources::MeshBuffers;
@@ -14,7 +15,6 @@ use dermis::skin::blur::{BlurChain, BlurKernel};
 use dermis::skin::profile::{gaussian, Kernel, Profile};
 use dermis::skin::stretch::StretchPass;
 use dermis::skin::{mean_stretch, UV_FORMAT};
-use dermis::testscene::readback_pass;
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
 

@@ -1,6 +1,7 @@
-//! One-shot uploads through the graph: static buffers and textures (with GPU
-//! mip generation). Each runs a tiny graph on its own executor and waits, so
-//! nothing transient outlives it; the results are left ready for any shader.
+//! Moving data between host and device through the graph: one-shot uploads of
+//! static buffers and textures (with GPU mip generation; each runs a tiny graph on
+//! its own executor and waits, and leaves the result ready for any shader), and
+//! the readback pass frames end with.
 
 use super::{Access, Executor, Graph, Imported};
 use crate::error::{Error, Result};
@@ -137,4 +138,18 @@ fn run_once(ctx: &Arc<Context>, g: Graph) -> Result<()> {
     ex.run(g)?;
     ex.finish()?;
     Ok(())
+}
+
+/// Copies `image` into a host-visible buffer and leaves it ready for the host.
+pub fn readback_pass(g: &mut Graph, image: &super::ImageHandle, buffer: &Arc<Buffer>) {
+    let mut out = g.import_buffer(
+        "readback",
+        Imported::Buffer(buffer.clone()),
+        Some(Access::HostRead),
+        Some(Access::HostRead),
+    );
+    let mut p = g.add_pass("readback");
+    let src = p.read(image, Access::TransferSrc);
+    let dst = p.write_buffer(&mut out, Access::TransferDst);
+    p.record(move |cx| cx.copy_image_to_buffer(src, dst));
 }

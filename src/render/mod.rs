@@ -7,6 +7,7 @@ pub mod resources;
 
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, ContextOptions, DeviceInfo, ImageDesc, MemoryLocation};
+use crate::graph::upload::readback_pass;
 use crate::graph::upload::upload_buffer;
 use crate::graph::ImageHandle;
 use crate::graph::{Access, Executor, Graph};
@@ -20,7 +21,6 @@ use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::ShadePass;
 use crate::skin::stretch::StretchPass;
 use crate::skin::{mean_stretch, SkinSettings};
-use crate::testscene::readback_pass;
 use ash::vk;
 use forward::{ForwardInputs, ForwardPipelines, FrameUniforms, HDR_FORMAT, MAX_LIGHTS};
 use resources::{upload_env, upload_rgba8, MeshBuffers, Samplers};
