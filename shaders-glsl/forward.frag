@@ -21,18 +21,18 @@ layout(location = 6) in vec3 v_t678;
 #include "lighting.glsl"
 layout(location = 0) out vec4 color;
 
+#include "normal_map.glsl"
+
 vec3 shading_normal() {
-    vec3 n = normalize(v_normal);
-    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
-    vec3 b = cross(n, t) * v_tangent.w;
-    vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
-    vec3 s = normalize(m.x * t + m.y * b + m.z * n);
-    return gl_FrontFacing ? s : -s;
+    vec3 s = map_normal(normal_tex, v_uv, v_normal, v_tangent);
+    // Two-sided by the geometric normal, whatever the mesh's winding.
+    vec3 v = frame.camera_pos.xyz - v_position;
+    return dot(v_normal, v) < 0.0 ? -s : s;
 }
 
 void main() {
     vec3 n = shading_normal();
-    vec3 e = irradiance_at(n);
+    vec3 e = irradiance_at(n, vec2(0.0));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     color = vec4(albedo / PI_F * e, 1.0);
 }

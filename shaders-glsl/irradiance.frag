@@ -7,7 +7,7 @@
 #include "sh.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
-layout(push_constant) uniform Push { float mix_pre; } pc;
+layout(push_constant) uniform Push { float mix_pre; uint roughness_map; } pc;
 // SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
 // (rgb), rotated and scaled by the environment intensity.
 layout(std430, binding = 3) readonly buffer Lighting { vec4 sh[9]; } lighting;
@@ -18,16 +18,21 @@ layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
+#define SPEC_BECKMANN 5
+#define SPEC_ALBEDO 6
+#define SPEC_REGIONS 7
+#define SPEC_INTENSITY 8
+#define SPEC_ROUGHNESS 9
+#define SPEC_PARAMS 10
+#include "ks_specular.glsl"
+#include "normal_map.glsl"
+#define ENERGY_CONSERVING_LIGHTS
 #include "lighting.glsl"
 layout(location = 0) out vec4 irradiance;
 
 void main() {
-    vec3 n = normalize(v_normal);
-    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
-    vec3 b = cross(n, t) * v_tangent.w;
-    vec3 m = texture(normal_tex, v_uv).xyz * 2.0 - 1.0;
-    n = normalize(m.x * t + m.y * b + m.z * n);
-    vec3 e = irradiance_at(n);
+    vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
+    vec3 e = irradiance_at(n, specular_params(v_uv, pc.roughness_map != 0u));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
 }

@@ -11,7 +11,17 @@ layout(binding = 4) uniform sampler2D blur3;
 layout(binding = 5) uniform sampler2D blur4;
 layout(binding = 6) uniform sampler2D blur5;
 layout(binding = 7) uniform sampler2D blur6;
-layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; } pc;
+layout(binding = 8) uniform sampler2D normal_tex;
+#define SPEC_BECKMANN 9
+#define SPEC_ALBEDO 10
+#define SPEC_REGIONS 11
+#define SPEC_INTENSITY 12
+#define SPEC_ROUGHNESS 13
+#define SPEC_PARAMS 14
+#include "ks_specular.glsl"
+#include "normal_map.glsl"
+// mode: 0 final, 1 diffuse only, 2 specular only.
+layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; uint roughness_map; } pc;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -28,6 +38,18 @@ vec3 level(sampler2D t, int i) {
 void main() {
     vec3 diffuse = level(blur1, 0) + level(blur2, 1) + level(blur3, 2)
                  + level(blur4, 3) + level(blur5, 4) + level(blur6, 5);
+    vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
+    vec3 v = normalize(frame.camera_pos.xyz - v_position);
+    // Two-sided by the geometric normal, whatever the mesh's winding.
+    if (dot(v_normal, v) < 0.0) n = -n;
+    vec2 params = specular_params(v_uv, pc.roughness_map != 0u);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
-    color = vec4(diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI, 1.0);
+    // Light leaving the skin loses what the oil layer reflects toward the viewer.
+    vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI
+             * diffuse_transmission(dot(n, v), params);
+    vec3 spec = vec3(0.0);
+    for (int i = 0; i < int(frame.env.z); ++i) {
+        spec += frame.light_color[i].rgb * ks_specular(n, frame.light_dir[i].xyz, v, params);
+    }
+    color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);
 }

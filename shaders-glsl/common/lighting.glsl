@@ -2,7 +2,9 @@
 // occlusion, E = Σ L_i·T_i from the interpolated per-vertex transfer (the paper's
 // eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
 // directional lights. Needs frame.glsl, sh.glsl, the Lighting buffer and v_t*.
-vec3 irradiance_at(vec3 n) {
+// With ENERGY_CONSERVING_LIGHTS (and ks_specular.glsl), each light is scaled by
+// 1 − ρs·A(N·L, m): what the specular reflects does not enter the skin.
+vec3 irradiance_at(vec3 n, vec2 spec_params) {
     vec3 e;
     if (frame.env.w > 0.5) {
         float t[9] = float[9](v_t012.x, v_t012.y, v_t012.z, v_t345.x, v_t345.y, v_t345.z,
@@ -14,7 +16,11 @@ vec3 irradiance_at(vec3 n) {
     }
     e = max(e, vec3(0.0));
     for (int i = 0; i < int(frame.env.z); ++i) {
-        e += frame.light_color[i].rgb * max(dot(n, frame.light_dir[i].xyz), 0.0);
+        float n_dot_l = max(dot(n, frame.light_dir[i].xyz), 0.0);
+#ifdef ENERGY_CONSERVING_LIGHTS
+        n_dot_l *= diffuse_transmission(n_dot_l, spec_params);
+#endif
+        e += frame.light_color[i].rgb * n_dot_l;
     }
     return e;
 }

@@ -94,11 +94,40 @@ pub struct ForwardInputs {
     pub specular: Arc<Image>,
     pub roughness: Arc<Image>,
     pub regions: Arc<Image>,
+    /// Whether the scene gave a roughness map (else the regions' m is used).
+    pub roughness_map: bool,
+    pub tables: crate::skin::tables::SpecularTables,
     pub env: Arc<Image>,
     /// Linear where the device filters RGBA32F, else nearest.
     pub env_sampler: Arc<crate::gpu::Sampler>,
     pub samplers: Arc<Samplers>,
 }
+
+impl ForwardInputs {
+    /// The six specular bindings of common/ks_specular.glsl, in order.
+    pub fn specular_descriptors(&self) -> [Descriptor<'_>; 6] {
+        let t = &self.tables;
+        let s = &self.samplers;
+        [
+            Descriptor::StaticSampled(&t.beckmann, &t.sampler),
+            Descriptor::StaticSampled(&t.albedo, &t.sampler),
+            Descriptor::StaticSampled(&self.regions, &s.nearest),
+            Descriptor::StaticSampled(&self.specular, &s.linear),
+            Descriptor::StaticSampled(&self.roughness, &s.linear),
+            Descriptor::StaticStorage(&t.regions),
+        ]
+    }
+}
+
+/// The specular bindings' kinds, matching [`ForwardInputs::specular_descriptors`].
+pub const SPECULAR_BINDINGS: [Binding; 6] = [
+    Binding::SampledImage,
+    Binding::SampledImage,
+    Binding::SampledImage,
+    Binding::SampledImage,
+    Binding::SampledImage,
+    Binding::StorageBuffer,
+];
 
 /// The environment seen through the camera, clearing `hdr`.
 pub fn background(

@@ -18,7 +18,7 @@ use crate::scene::file::{Occlusion, SceneFile};
 use crate::scene::Scene;
 use crate::skin::blur::BlurChain;
 use crate::skin::irradiance::IrradiancePass;
-use crate::skin::shade::ShadePass;
+use crate::skin::shade::{ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::stretch::StretchPass;
 use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
@@ -33,6 +33,8 @@ pub enum View {
     Final,
     /// The diffuse (subsurface) term alone.
     Diffuse,
+    /// The Kelemen/Szirmay-Kalos specular term alone (the paper's Fig. 1).
+    Specular,
     /// Direct diffuse shading in screen space, no scattering (for comparison).
     Direct,
     /// The per-vertex transfer's DC term relative to open sky (1 = unoccluded).
@@ -50,6 +52,7 @@ impl View {
         Ok(match s {
             "final" => View::Final,
             "diffuse" => View::Diffuse,
+            "specular" => View::Specular,
             "direct" => View::Direct,
             "occlusion" => View::Occlusion,
             "irradiance" => View::Irradiance,
@@ -58,7 +61,7 @@ impl View {
                 Some(k @ 1..=6) => View::Blur(k),
                 _ => {
                     return Err(Error::Input(format!(
-                    "unknown view {s:?}: final, diffuse, direct, occlusion, irradiance, stretch, blur1..blur6"
+                    "unknown view {s:?}: final, diffuse, specular, direct, occlusion, irradiance, stretch, blur1..blur6"
                 )))
                 }
             },
@@ -205,6 +208,13 @@ impl Frame {
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
             roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
             regions: upload_rgba8(ctx, "region map", &scene.regions)?,
+            roughness_map: scene.file.textures.roughness.is_some(),
+            tables: crate::skin::tables::SpecularTables::new(
+                ctx,
+                &scene.file.skin.regions,
+                samplers.linear.clone(),
+                samplers.nearest.clone(),
+            )?,
             env: upload_env(ctx, &scene.env)?,
             env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
                 samplers.linear.clone()
@@ -301,14 +311,18 @@ impl Frame {
                 .map(|g| g.weights)
                 .collect();
             let weights: [glam::Vec3; 6] = weights.try_into().unwrap_or([glam::Vec3::ZERO; 6]);
-            self.shade.pass(
-                g,
-                &self.inputs,
-                &levels.irradiance,
+            let mode = match view {
+                View::Diffuse => ShadeMode::Diffuse,
+                View::Specular => ShadeMode::Specular,
+                _ => ShadeMode::Full,
+            };
+            let settings = ShadeSettings {
                 weights,
-                self.skin.mix,
-                &mut hdr,
-            );
+                mix: self.skin.mix,
+                mode,
+            };
+            self.shade
+                .pass(g, &self.inputs, &levels.irradiance, settings, &mut hdr);
         }
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
         self.tonemap

@@ -114,8 +114,8 @@ pub const REGION_NAMES: [&str; REGION_COUNT] = [
 const EYE_CENTRE: Vec3 = Vec3::new(31.5, 3.0, 70.0);
 /// Adult eyeball diameter ≈ 24 mm.
 const EYE_RADIUS: f32 = 12.0;
-/// Eyelids: a 1.4 mm shell over the eyeball, cut open by the palpebral fissure.
-const LID_RADIUS: f32 = 13.4;
+/// Eyelids: a 2 mm shell over the eyeball, cut open by the palpebral fissure.
+const LID_RADIUS: f32 = 14.0;
 const CROWN_Y: f32 = 122.0;
 const STOMION_Y: f32 = -62.0;
 const NECK_BOTTOM_Y: f32 = -210.0;
@@ -191,9 +191,9 @@ pub fn sdf(p: Vec3) -> f32 {
     d = ellipsoid_union(
         d,
         q,
-        Vec3::new(45.0, -9.0, 60.0),
-        Vec3::new(16.0, 10.0, 16.0),
-        14.0,
+        Vec3::new(44.0, -12.0, 58.0),
+        Vec3::new(15.0, 9.0, 15.0),
+        16.0,
     );
     // Masseter and ramus: fill the side of the face between cheekbone and jaw angle.
     d = ellipsoid_union(
@@ -201,20 +201,20 @@ pub fn sdf(p: Vec3) -> f32 {
         q,
         Vec3::new(44.0, -50.0, 16.0),
         Vec3::new(13.0, 28.0, 24.0),
-        14.0,
+        16.0,
     );
-    // Jaw line from gonion (mandible width ≈ 100) to the chin; the chin (pogonion
-    // z ≈ 92, gnathion y ≈ −108).
-    let (ga, gb) = (Vec3::new(47.0, -74.0, 8.0), Vec3::new(15.0, -101.0, 72.0));
-    d = blend(d, q, (ga + gb) * 0.5, 45.0, 12.0, || {
-        sd_capsule(q, ga, gb, 8.0)
+    // Mandible: a tapering bar from the jaw angle (gonion, mandible width ≈ 100) to
+    // the chin, and the chin itself (pogonion z ≈ 92, gnathion y ≈ −108).
+    let (ga, gb) = (Vec3::new(44.0, -72.0, 8.0), Vec3::new(12.0, -98.0, 70.0));
+    d = blend(d, q, (ga + gb) * 0.5, 50.0, 20.0, || {
+        sd_round_cone(q, ga, gb, 7.0, 10.0)
     });
     d = ellipsoid_union(
         d,
         q,
-        Vec3::new(0.0, -95.0, 78.0),
-        Vec3::new(20.0, 13.5, 14.0),
-        10.0,
+        Vec3::new(0.0, -94.0, 77.0),
+        Vec3::new(19.0, 13.0, 14.0),
+        16.0,
     );
     // Dental arch under the lips: mouth corners sit ≈ 10 mm behind the lip centre.
     d = ellipsoid_union(
@@ -234,14 +234,14 @@ pub fn sdf(p: Vec3) -> f32 {
     d = smin(d, neck, 18.0);
 
     // Eye sockets (orbits), then eyelids and eyeballs inside them.
-    if (q - Vec3::new(31.5, 5.0, 80.0)).length() - 27.0 < (5.0 - d).max(d + 2.0) {
+    if (q - Vec3::new(31.5, 5.0, 80.0)).length() - 27.0 < (8.0 - d).max(d + 2.0) {
         d = smax(
             d,
             -sd_ellipsoid(q, Vec3::new(31.5, 6.0, 88.0), Vec3::new(18.0, 13.0, 12.0)),
-            5.0,
+            8.0,
         );
         d = smin(d, sd_eyelids(q), 2.0);
-        d = d.min((q - EYE_CENTRE).length() - EYE_RADIUS);
+        d = smin(d, (q - EYE_CENTRE).length() - EYE_RADIUS, 0.8);
     }
     // Nose: nasion at y ≈ 14, subnasale at y ≈ −40 (height 54), tip at z ≈ 112;
     // nostrils open from below with ≈ 5 mm alar walls.
@@ -261,8 +261,8 @@ pub fn sdf(p: Vec3) -> f32 {
         // Alae (nose wings): alar width ≈ 36 mm.
         nose = smin(
             nose,
-            sd_ellipsoid(q, Vec3::new(11.5, -33.5, 95.0), Vec3::new(6.5, 5.5, 9.0)),
-            5.0,
+            sd_ellipsoid(q, Vec3::new(11.0, -32.5, 94.0), Vec3::new(6.5, 5.5, 8.5)),
+            6.0,
         );
         // Columella.
         nose = smin(
@@ -278,7 +278,7 @@ pub fn sdf(p: Vec3) -> f32 {
         d = smin(d, nose, 6.0);
         d = smax(
             d,
-            -sd_ellipsoid(q, Vec3::new(7.5, -37.5, 97.0), Vec3::new(4.0, 3.5, 6.5)),
+            -sd_ellipsoid(q, Vec3::new(7.5, -36.5, 95.5), Vec3::new(4.5, 4.5, 5.5)),
             1.0,
         );
     }
@@ -286,7 +286,7 @@ pub fn sdf(p: Vec3) -> f32 {
     if (q - Vec3::new(0.0, STOMION_Y, 88.0)).length() - 31.0 < (d + 4.0).max(1.5 - d) {
         d = smin(
             d,
-            sd_ellipsoid(q, Vec3::new(0.0, -56.0, 88.0), Vec3::new(24.0, 6.5, 8.0)),
+            sd_ellipsoid(q, Vec3::new(0.0, -56.5, 88.0), Vec3::new(24.0, 6.0, 8.0)),
             4.0,
         );
         d = smin(
@@ -427,14 +427,19 @@ fn smax(a: f32, b: f32, k: f32) -> f32 {
 fn sd_eyelids(q: Vec3) -> f32 {
     let d = q - EYE_CENTRE;
     let shell = d.length() - LID_RADIUS;
-    // Opening, extruded along z; negative inside the fissure.
+    // Rounded lid margins: a smooth cut is resolved better by the mesh than a crease.
+    smax(shell, -fissure(d), 1.2)
+}
+
+/// Palpebral fissure as an implicit in the eye's frame (`d` = point − eye centre),
+/// extruded along z: negative inside the opening (≈ mm near its border).
+fn fissure(d: Vec3) -> f32 {
     let x = d.x;
-    let t = (1.0 - (x / 15.0).powi(2)).max(0.0);
+    let t = (1.0 - (x / 15.0).powi(2)).max(0.0).sqrt();
     let tilt = 0.07 * x;
-    let upper = tilt + 5.0 * t.sqrt() * (1.0 - 0.15 * x / 15.0);
-    let lower = tilt - 4.0 * t.sqrt();
-    let opening = (d.y - upper).max(lower - d.y);
-    shell.max(-opening)
+    let upper = tilt + 5.0 * t * (1.0 - 0.15 * x / 15.0);
+    let lower = tilt - 4.0 * t;
+    (d.y - upper).max(lower - d.y)
 }
 
 /// Frame of the left ear: `out` lateral (normal of the auricle), `up` along the ear's
@@ -1331,6 +1336,12 @@ fn gauss(p: Vec3, c: Vec3, sigma: f32) -> f32 {
     (-(p - c).length_squared() / (2.0 * sigma * sigma)).exp()
 }
 
+/// Whether a (mirrored) surface point lies on the visible part of an eyeball.
+fn on_eyeball(q: Vec3) -> bool {
+    let d = q - EYE_CENTRE;
+    d.z > 0.0 && d.length() < EYE_RADIUS + 0.9 && fissure(d) < 0.2
+}
+
 /// Vermilion mask of the lips (0..1), in mirrored coordinates.
 fn lip_mask(q: Vec3) -> f32 {
     if q.z < 76.0 {
@@ -1339,7 +1350,7 @@ fn lip_mask(q: Vec3) -> f32 {
     let tu = (1.0 - (q.x / 25.0).powi(2)).max(0.0);
     let tl = (1.0 - (q.x / 23.0).powi(2)).max(0.0);
     // Cupid's bow: a dip at the midline between two peaks.
-    let upper = STOMION_Y + 8.5 * tu.powf(0.45) - 1.3 * (-(q.x / 3.5).powi(2)).exp();
+    let upper = STOMION_Y + 10.0 * tu.powf(0.45) - 1.3 * (-(q.x / 3.5).powi(2)).exp();
     let lower = STOMION_Y - 9.5 * tl.powf(0.6);
     smoothstep(-0.7, 0.7, upper - q.y) * smoothstep(-0.7, 0.7, q.y - lower)
 }
@@ -1362,7 +1373,7 @@ fn albedo_at(p: Vec3, region: u8, pore: f32, seed: u32, pal: &Palette) -> Vec3 {
     let q = Vec3::new(p.x.abs(), p.y, p.z);
     // Eyeballs (gaze straight ahead along +Z): sclera, iris, pupil.
     let de = q - EYE_CENTRE;
-    if de.length() < EYE_RADIUS + 0.7 && de.z > 0.0 {
+    if on_eyeball(q) {
         let rho = Vec2::new(de.x, de.y).length();
         let ang = de.y.atan2(de.x);
         let fibres = value_noise(Vec3::new(ang * 9.0, rho * 1.5, 0.0), seed ^ 0x1415);
@@ -1371,7 +1382,10 @@ fn albedo_at(p: Vec3, region: u8, pore: f32, seed: u32, pal: &Palette) -> Vec3 {
             smoothstep(7.0, 11.0, rho) * smoothstep(0.3, 0.9, fbm(de * 0.8, 3, seed ^ 0x77));
         let sclera = pal.sclera.lerp(pal.flush, 0.35 * vessels);
         let c = sclera.lerp(iris, 1.0 - smoothstep(5.6, 6.1, rho));
-        return c.lerp(pal.pupil, 1.0 - smoothstep(1.9, 2.3, rho));
+        let c = c.lerp(pal.pupil, 1.0 - smoothstep(1.9, 2.3, rho));
+        // Shadowed, moist lid margin (and the pink caruncle medially) at the border.
+        let margin = smoothstep(-1.8, 0.2, fissure(de));
+        return c.lerp(pal.flush * 0.55, margin * 0.8);
     }
     // Skin: slow tone variation (brightness and red/yellow balance).
     let mut c = pal.skin;
@@ -1379,7 +1393,7 @@ fn albedo_at(p: Vec3, region: u8, pore: f32, seed: u32, pal: &Palette) -> Vec3 {
     let hue = fbm(p / 9.0 + Vec3::splat(17.0), 3, seed ^ 0x51);
     c *= Vec3::new(1.0 + 0.04 * hue, 1.0, 1.0 - 0.06 * hue);
     // Flush: cheeks, nose tip, ears, chin; artistic placement.
-    let mut red = 0.55 * gauss(q, Vec3::new(43.0, -25.0, 70.0), 14.0)
+    let mut red = 0.35 * gauss(q, Vec3::new(42.0, -24.0, 70.0), 17.0)
         + 0.6 * gauss(q, Vec3::new(0.0, -28.0, 110.0), 9.0)
         + 0.25 * gauss(q, Vec3::new(12.0, -33.0, 98.0), 6.0)
         + 0.2 * gauss(q, Vec3::new(0.0, -96.0, 90.0), 12.0);
@@ -1396,7 +1410,7 @@ fn albedo_at(p: Vec3, region: u8, pore: f32, seed: u32, pal: &Palette) -> Vec3 {
         c = c.lerp(pal.lip * lines, lip);
     }
     // Darker, redder inside the nostrils.
-    let nostril = gauss(q, Vec3::new(7.5, -36.0, 97.0), 4.0);
+    let nostril = gauss(q, Vec3::new(7.5, -35.0, 96.5), 4.0);
     c = c.lerp(pal.flush * 0.6, (nostril * 1.5).min(0.7));
     // Eyebrows: streaky hairs along the arch.
     let brow = brow_mask(q);
@@ -1469,7 +1483,7 @@ fn detail_normal(
 ) -> Vec3 {
     use std::f32::consts::TAU;
     let q = Vec3::new(p.x.abs(), p.y, p.z);
-    if (q - EYE_CENTRE).length() < EYE_RADIUS + 0.7 && q.z > EYE_CENTRE.z {
+    if on_eyeball(q) {
         return Vec3::Z;
     }
     // Gradient of the height field in 3D (mm/mm).
@@ -1482,8 +1496,8 @@ fn detail_normal(
     let lip = lip_mask(q);
     if lip > 0.0 {
         let wob = fbm(p / 2.0, 2, seed ^ 0x67);
-        let w = TAU / 1.3;
-        grad.x += 0.03 * lip * w * (q.x * w + 2.0 * wob).cos() * p.x.signum();
+        let w = TAU / 1.1;
+        grad.x += 0.012 * lip * w * (q.x * w + 4.0 * wob).cos() * p.x.signum();
     }
     let mut dt = grad.dot(t);
     let mut db = grad.dot(b);

@@ -5,7 +5,7 @@ use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::gpu::{Binding, Context, ImageDesc, Pipeline};
 use crate::graph::{Access, BufferHandle, Descriptor, Graph, ImageHandle, LoadOp};
-use crate::render::forward::ForwardInputs;
+use crate::render::forward::{ForwardInputs, SPECULAR_BINDINGS};
 use std::sync::Arc;
 
 pub struct IrradiancePass {
@@ -20,13 +20,17 @@ impl IrradiancePass {
                 "uv_lit.vert",
                 "irradiance.frag",
                 &[
-                    Binding::UniformBuffer,
-                    Binding::SampledImage,
-                    Binding::SampledImage,
-                    Binding::StorageBuffer,
-                    Binding::StorageBuffer,
-                ],
-                4,
+                    &[
+                        Binding::UniformBuffer,
+                        Binding::SampledImage,
+                        Binding::SampledImage,
+                        Binding::StorageBuffer,
+                        Binding::StorageBuffer,
+                    ][..],
+                    &SPECULAR_BINDINGS,
+                ]
+                .concat(),
+                8,
             )?,
         })
     }
@@ -50,17 +54,16 @@ impl IrradiancePass {
         let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
         p.record(move |cx| {
             cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::StaticUniform(&inp.uniforms),
-                    Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
-                    Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
-                    Descriptor::Storage(coeffs),
-                    Descriptor::StaticStorage(&inp.transfer),
-                ],
-            );
-            cx.push_constants(&pipe, &mix);
+            let mut d = vec![
+                Descriptor::StaticUniform(&inp.uniforms),
+                Descriptor::StaticSampled(&inp.albedo, &inp.samplers.linear),
+                Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
+                Descriptor::Storage(coeffs),
+                Descriptor::StaticStorage(&inp.transfer),
+            ];
+            d.extend(inp.specular_descriptors());
+            cx.push_descriptors(&pipe, &d);
+            cx.push_constants(&pipe, &[mix.to_bits(), u32::from(inp.roughness_map)]);
             inp.mesh.draw(cx);
         });
         out

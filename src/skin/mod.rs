@@ -8,6 +8,7 @@ pub mod profile;
 pub mod shade;
 pub mod specular;
 pub mod stretch;
+pub mod tables;
 
 use crate::error::Result;
 use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};

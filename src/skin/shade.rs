@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
 use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
-use crate::render::forward::{ForwardInputs, DEPTH_FORMAT, HDR_FORMAT};
+use crate::render::forward::{ForwardInputs, DEPTH_FORMAT, HDR_FORMAT, SPECULAR_BINDINGS};
 use crate::render::resources::{Vertex, VERTEX_ATTRIBUTES};
 use ash::vk;
 use std::sync::Arc;
@@ -14,6 +14,27 @@ use std::sync::Arc;
 struct ShadePush {
     weights: [[f32; 4]; 6],
     mix_pre: f32,
+    mode: u32,
+    roughness_map: u32,
+}
+
+/// The profile weights, albedo split and output of the final pass.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeSettings {
+    /// RGB weight of each Gaussian (the paper's Fig. 2).
+    pub weights: [glam::Vec3; 6],
+    /// Pre-scatter share of the albedo.
+    pub mix: f32,
+    pub mode: ShadeMode,
+}
+
+/// What the final pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadeMode {
+    /// Subsurface diffuse plus specular.
+    Full = 0,
+    Diffuse = 1,
+    Specular = 2,
 }
 
 pub struct ShadePass {
@@ -23,7 +44,8 @@ pub struct ShadePass {
 impl ShadePass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
         let mut bindings = vec![Binding::UniformBuffer, Binding::SampledImage];
-        bindings.extend([Binding::SampledImage; 6]);
+        bindings.extend([Binding::SampledImage; 7]);
+        bindings.extend(SPECULAR_BINDINGS);
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -46,8 +68,7 @@ impl ShadePass {
         g: &mut Graph,
         inputs: &Arc<ForwardInputs>,
         levels: &[ImageHandle],
-        weights: [glam::Vec3; 6],
-        mix: f32,
+        settings: ShadeSettings,
         hdr: &mut ImageHandle,
     ) {
         let (w, h) = (hdr.desc.width, hdr.desc.height);
@@ -61,8 +82,10 @@ impl ShadePass {
         p.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
         let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
         let push = ShadePush {
-            weights: weights.map(|w| w.extend(0.0).into()),
-            mix_pre: mix,
+            weights: settings.weights.map(|w| w.extend(0.0).into()),
+            mix_pre: settings.mix,
+            mode: settings.mode as u32,
+            roughness_map: u32::from(inputs.roughness_map),
         };
         p.record(move |cx| {
             cx.bind(&pipe);
@@ -72,6 +95,8 @@ impl ShadePass {
                 Descriptor::StaticSampled(&inp.albedo, sampler),
             ];
             d.extend(refs.iter().map(|&r| Descriptor::Sampled(r, sampler)));
+            d.push(Descriptor::StaticSampled(&inp.normal, sampler));
+            d.extend(inp.specular_descriptors());
             cx.push_descriptors(&pipe, &d);
             cx.push_constants(&pipe, &push);
             inp.mesh.draw(cx);

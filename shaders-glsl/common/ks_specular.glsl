@@ -1,0 +1,70 @@
+// Kelemen/Szirmay-Kalos specular (the paper's eq. 1; d'Eon & Luebke, GPU Gems 3
+// §14.3, KS_Skin_Specular) with per-region parameters. Expects these bindings
+// (numbers set by the including shader through the SPEC_* macros):
+//   SPEC_BECKMANN  sampler2D  D(N·H, m), skin/specular.rs::beckmann_lut
+//   SPEC_ALBEDO    sampler2D  A(cos θ, m), skin/specular.rs::specular_albedo_lut
+//   SPEC_REGIONS   sampler2D  region id in R (texel = id / 255)
+//   SPEC_INTENSITY sampler2D  ρs scale (the specular map)
+//   SPEC_ROUGHNESS sampler2D  m (grey), used when roughness_map != 0
+//   SPEC_PARAMS    buffer     per region (ρs, m)
+layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
+layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
+layout(binding = SPEC_REGIONS) uniform sampler2D region_tex;
+layout(binding = SPEC_INTENSITY) uniform sampler2D intensity_tex;
+layout(binding = SPEC_ROUGHNESS) uniform sampler2D roughness_tex;
+layout(std430, binding = SPEC_PARAMS) readonly buffer RegionParams { vec4 region_params[10]; };
+
+// Endpoint-inclusive tables (skin/specular.rs::table_point): x = i/(n−1) at texel i.
+vec2 table_uv(sampler2D table, vec2 x) {
+    vec2 n = vec2(textureSize(table, 0));
+    return (clamp(x, 0.0, 1.0) * (n - 1.0) + 0.5) / n;
+}
+
+const float F0_SKIN = 0.028;   // Schlick F0 of skin's oil layer (n ≈ 1.4), GPU Gems 3 §14.3
+const float REGION_BLEND_TEXELS = 4.0;   // region borders blend over ±8 texels
+
+// (ρs, m) at uv: region parameters blended with tent weights over a 3×3 grid of
+// region-map texels REGION_BLEND_TEXELS apart, so borders are soft, not hard edges.
+vec2 specular_params(vec2 uv, bool roughness_map) {
+    ivec2 size = textureSize(region_tex, 0);
+    vec2 acc = vec2(0.0);
+    float total = 0.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            vec2 p = uv * vec2(size) + vec2(dx, dy) * REGION_BLEND_TEXELS;
+            ivec2 t = clamp(ivec2(floor(p)), ivec2(0), size - 1);
+            int id = min(int(texelFetch(region_tex, t, 0).r * 255.0 + 0.5), 9);
+            float w = (2.0 - abs(float(dx))) * (2.0 - abs(float(dy)));
+            acc += w * region_params[id].xy;
+            total += w;
+        }
+    }
+    vec2 params = acc / total;
+    params.x *= texture(intensity_tex, uv).r;
+    if (roughness_map) params.y = texture(roughness_tex, uv).r;
+    params.y = clamp(params.y, 0.02, 1.0);
+    return params;
+}
+
+float fresnel_schlick(float h_dot_v, float f0) {
+    float base = 1.0 - h_dot_v;
+    return f0 + (1.0 - f0) * base * base * base * base * base;
+}
+
+// N·L · ρs · D·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h) stands for
+// the microfacet denominator); D from the Beckmann table.
+float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
+    float n_dot_l = dot(n, l);
+    if (n_dot_l <= 0.0) return 0.0;
+    vec3 h = l + v;
+    vec3 hn = normalize(h);
+    float d = texture(beckmann_lut, table_uv(beckmann_lut, vec2(dot(n, hn), params.y))).r;
+    float f = fresnel_schlick(dot(hn, v), F0_SKIN);
+    return n_dot_l * params.x * max(d * f / dot(h, h), 0.0);
+}
+
+// Energy conservation: the share of light at angle θ the specular does not take,
+// 1 − ρs·A(cos θ, m) (GPU Gems 3 §14.3).
+float diffuse_transmission(float cos_theta, vec2 params) {
+    return 1.0 - params.x * texture(albedo_lut, table_uv(albedo_lut, vec2(cos_theta, params.y))).r;
+}
