@@ -242,7 +242,14 @@ fn views_write_intermediates() {
     assert!(covered
         .iter()
         .all(|p| p[0] > 0.0 && p[0].is_finite() && p[1] > 0.0));
-    for view in ["blur6", "irradiance", "diffuse", "specular", "direct", "occlusion"] {
+    for view in [
+        "blur6",
+        "irradiance",
+        "diffuse",
+        "specular",
+        "direct",
+        "occlusion",
+    ] {
         let png = tmp(&format!("{view}.png"));
         let out = dermis(&[
             "render",
