@@ -278,12 +278,12 @@ pub fn sdf(p: Vec3) -> f32 {
         d = smin(d, nose, 6.0);
         d = smax(
             d,
-            -sd_ellipsoid(q, Vec3::new(7.5, -36.5, 95.5), Vec3::new(4.5, 4.5, 5.5)),
+            -sd_ellipsoid(q, Vec3::new(8.5, -34.5, 94.0), Vec3::new(4.8, 4.5, 5.0)),
             1.0,
         );
     }
-    // Lips: upper and lower vermilion bulges, and the mouth line between them.
-    if (q - Vec3::new(0.0, STOMION_Y, 88.0)).length() - 31.0 < (d + 4.0).max(1.5 - d) {
+    // Lips: upper and lower vermilion bulges; the mouth line is the crease between.
+    if (q - Vec3::new(0.0, STOMION_Y, 88.0)).length() - 31.0 < d + 4.0 {
         d = smin(
             d,
             sd_ellipsoid(q, Vec3::new(0.0, -56.5, 88.0), Vec3::new(24.0, 6.0, 8.0)),
@@ -293,15 +293,6 @@ pub fn sdf(p: Vec3) -> f32 {
             d,
             sd_ellipsoid(q, Vec3::new(0.0, -68.0, 86.0), Vec3::new(22.0, 6.5, 8.0)),
             4.0,
-        );
-        d = smax(
-            d,
-            -sd_ellipsoid(
-                q,
-                Vec3::new(0.0, STOMION_Y, 96.0),
-                Vec3::new(25.0, 1.0, 10.0),
-            ),
-            1.5,
         );
     }
     // Ears, fused to the head at the front; the concha digs a bowl toward the canal.
@@ -560,8 +551,10 @@ fn sdf_and_gradient(p: Vec3) -> (f32, Vec3) {
 // is closed; quads are oriented by the edge's sign, so it is consistently oriented.
 
 fn surface_nets(h: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
-    let lo = Vec3::new(-96.0, NECK_BOTTOM_Y - 2.0 * h, -112.0);
-    let hi = Vec3::new(96.0, CROWN_Y + 2.0 * h, 126.0);
+    // Symmetric in x about 0, so the mesh is mirror-symmetric like the field.
+    let half_x = (96.0 / h).ceil() * h;
+    let lo = Vec3::new(-half_x, NECK_BOTTOM_Y - 2.0 * h, -112.0);
+    let hi = Vec3::new(half_x, CROWN_Y + 2.0 * h, 126.0);
     let dims = ((hi - lo) / h).ceil();
     let (nx, ny, nz) = (
         dims.x as usize + 1,
@@ -683,6 +676,23 @@ fn surface_nets(h: f32) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
                         tris.push([quad[1], quad[2], quad[3]]);
                     }
                 }
+            }
+        }
+    }
+    // Where the field's gradient is unreliable (features thinner than a cell), use
+    // the area-weighted normal of the adjacent faces instead.
+    let mut face_n = vec![Vec3::ZERO; verts.len()];
+    for t in &tris {
+        let [a, b, c] = t.map(|i| verts[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            face_n[i as usize] += n;
+        }
+    }
+    for (n, f) in normals.iter_mut().zip(face_n) {
+        if let Some(f) = f.try_normalize() {
+            if n.dot(f) < 0.3 {
+                *n = f;
             }
         }
     }
@@ -859,8 +869,10 @@ fn build_charts(pos: &[Vec3], tris: &[[u32; 3]]) -> Vec<Chart> {
         }
     }
 
-    // Charts; split those whose projection overlaps itself (e.g. an ear over the
-    // side of the head) by depth along their axis until each is one-to-one.
+    // Charts; repair those whose projection overlaps itself. Where the overlap comes
+    // from slanted triangles (an overhang), those move to their next-best axis; where
+    // whole layers overlap (e.g. an ear's rim over its own plate), the chart is split
+    // by depth along its axis. Repeat until every chart is one-to-one.
     let mut pending: Vec<Chart> = components(&all, &adj, &label)
         .into_iter()
         .map(|tris| Chart {
@@ -873,7 +885,7 @@ fn build_charts(pos: &[Vec3], tris: &[[u32; 3]]) -> Vec<Chart> {
     let mut part = vec![0u32; tris.len()];
     let mut budget = 400;
     while let Some(chart) = pending.pop() {
-        let Some(split_depth) = self_overlap_depth(pos, tris, &chart) else {
+        let Some(pairs) = self_overlaps(pos, tris, &chart) else {
             charts.push(chart);
             continue;
         };
@@ -884,30 +896,58 @@ fn build_charts(pos: &[Vec3], tris: &[[u32; 3]]) -> Vec<Chart> {
         }
         budget -= 1;
         let axis = AXES[chart.axis];
-        for &t in &chart.tris {
-            let c = tris[t as usize].map(|i| pos[i as usize].dot(axis));
-            part[t as usize] = u32::from((c[0] + c[1] + c[2]) / 3.0 >= split_depth);
-        }
-        let mut pieces = components(&chart.tris, &adj, &part);
-        if pieces.len() < 2 {
-            // Should not happen; fall back to halving the list.
+        let facing = |t: u32| normals[t as usize].dot(axis);
+        let losers: Vec<u32> = pairs
+            .iter()
+            .map(|&(a, b)| if facing(a) <= facing(b) { a } else { b })
+            .collect();
+        let pieces = if losers.iter().all(|&t| facing(t) < 0.7) {
+            for &t in &losers {
+                let n = normals[t as usize];
+                let next = (0..6)
+                    .filter(|&a| a != chart.axis)
+                    .max_by(|&a, &b| n.dot(AXES[a]).total_cmp(&n.dot(AXES[b])))
+                    .unwrap_or(chart.axis);
+                label[t as usize] = (label[t as usize] / 6) * 6 + next as u32;
+            }
+            components(&chart.tris, &adj, &label)
+        } else {
+            let depth = |t: u32| {
+                tris[t as usize]
+                    .iter()
+                    .map(|&i| pos[i as usize].dot(axis))
+                    .sum::<f32>()
+                    / 3.0
+            };
+            let mut mids: Vec<f32> = pairs
+                .iter()
+                .map(|&(a, b)| 0.5 * (depth(a) + depth(b)))
+                .collect();
+            mids.sort_by(f32::total_cmp);
+            let split = mids[mids.len() / 2];
+            for &t in &chart.tris {
+                part[t as usize] = u32::from(depth(t) >= split);
+            }
+            components(&chart.tris, &adj, &part)
+        };
+        let pieces = if pieces.len() < 2 {
+            // Cannot happen (the overlapping triangles end up apart); halve anyway.
             let half = chart.tris.len() / 2;
-            pieces = vec![chart.tris[..half].to_vec(), chart.tris[half..].to_vec()];
-        }
+            vec![chart.tris[..half].to_vec(), chart.tris[half..].to_vec()]
+        } else {
+            pieces
+        };
         for tris in pieces.into_iter().rev() {
-            pending.push(Chart {
-                axis: chart.axis,
-                tris,
-            });
+            let axis = (label[tris[0] as usize] % 6) as usize;
+            pending.push(Chart { axis, tris });
         }
     }
     charts
 }
 
-/// Rasterises a chart's projection at `OVERLAP_CHECK_MM`; if two triangles cover the
-/// same sample, returns a depth (along the chart axis) that separates the overlapping
-/// layers (median of the overlapping pairs' mean depths).
-fn self_overlap_depth(pos: &[Vec3], tris: &[[u32; 3]], chart: &Chart) -> Option<f32> {
+/// Rasterises a chart's projection at `OVERLAP_CHECK_MM`; returns the pairs of
+/// triangles (mesh ids) that cover the same sample, if any.
+fn self_overlaps(pos: &[Vec3], tris: &[[u32; 3]], chart: &Chart) -> Option<Vec<(u32, u32)>> {
     let uv: Vec<[Vec2; 3]> = chart
         .tris
         .iter()
@@ -926,28 +966,18 @@ fn self_overlap_depth(pos: &[Vec3], tris: &[[u32; 3]], chart: &Chart) -> Option<
     let mut pairs = Vec::new();
     for (k, t) in uv.iter().enumerate() {
         let t = t.map(|p| p - lo);
+        let id = chart.tris[k];
         raster_triangle(&t, w, h, 1e-3, |x, y, _| {
             let o = &mut owner[y * w + x];
-            if *o != u32::MAX && pairs.len() < 4096 {
-                pairs.push((*o, k as u32));
+            if *o != u32::MAX && *o != id && pairs.len() < 4096 {
+                pairs.push((*o, id));
             }
-            *o = k as u32;
+            *o = id;
         });
     }
-    if pairs.is_empty() {
-        return None;
-    }
-    let axis = AXES[chart.axis];
-    let depth = |k: u32| {
-        let t = tris[chart.tris[k as usize] as usize];
-        t.iter().map(|&i| pos[i as usize].dot(axis)).sum::<f32>() / 3.0
-    };
-    let mut mids: Vec<f32> = pairs
-        .iter()
-        .map(|&(a, b)| 0.5 * (depth(a) + depth(b)))
-        .collect();
-    mids.sort_by(f32::total_cmp);
-    Some(mids[mids.len() / 2])
+    pairs.sort_unstable();
+    pairs.dedup();
+    (!pairs.is_empty()).then_some(pairs)
 }
 
 /// Calls `f(x, y, barycentrics)` for every pixel centre (x + ½, y + ½) inside the
@@ -998,8 +1028,9 @@ struct Packing {
     offset: Vec<Vec2>,
 }
 
-/// Shelf-packs the charts at the largest common scale that fits, `pad` texels round
-/// each chart (so ≥ 2·pad texels between charts and from the border... minus nothing).
+/// Shelf-packs the charts (tallest first) at the largest common scale that fits,
+/// keeping `pad` texels free round each chart: ≥ 2·pad + 1 texel centres between
+/// the texels of two charts.
 fn pack_charts(pos: &[Vec3], tris: &[[u32; 3]], charts: &[Chart], size: u32, pad: u32) -> Packing {
     let mut min_mm = Vec::with_capacity(charts.len());
     let mut ext = Vec::with_capacity(charts.len());
@@ -1098,6 +1129,7 @@ fn compute_tangents(mesh: &Mesh) -> Vec<Vec4> {
     let n = mesh.positions.len();
     let mut tan = vec![Vec3::ZERO; n];
     let mut bit = vec![Vec3::ZERO; n];
+    let mut face_n = vec![Vec3::ZERO; n];
     for t in mesh.indices.chunks_exact(3) {
         let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
         let (e1, e2) = (
@@ -1116,6 +1148,7 @@ fn compute_tangents(mesh: &Mesh) -> Vec<Vec4> {
         for v in [a, b, c] {
             tan[v] += tu * w;
             bit[v] += tv * w;
+            face_n[v] += e1.cross(e2);
         }
     }
     (0..n)
@@ -1124,7 +1157,10 @@ fn compute_tangents(mesh: &Mesh) -> Vec<Vec4> {
             let t = (tan[i] - nn * nn.dot(tan[i]))
                 .try_normalize()
                 .unwrap_or_else(|| nn.any_orthonormal_vector());
-            let w = if nn.cross(t).dot(bit[i]) < 0.0 {
+            // Handedness from the faces' own orientation (robust where the shading
+            // normal of a sub-cell feature disagrees with its faces).
+            let gn = face_n[i].try_normalize().unwrap_or(nn);
+            let w = if gn.dot(tan[i].cross(bit[i])) < 0.0 {
                 -1.0
             } else {
                 1.0
@@ -1409,8 +1445,13 @@ fn albedo_at(p: Vec3, region: u8, pore: f32, seed: u32, pal: &Palette) -> Vec3 {
         let lines = 1.0 + 0.06 * value_noise(Vec3::new(q.x * 1.8, q.y * 0.25, 0.0), seed ^ 0x3);
         c = c.lerp(pal.lip * lines, lip);
     }
+    // The mouth line: a dark crease between the lips.
+    if q.z > 80.0 && q.x < 26.0 {
+        let crease = (-((q.y - STOMION_Y) / 0.9).powi(2)).exp() * smoothstep(26.0, 20.0, q.x);
+        c *= 1.0 - 0.6 * crease;
+    }
     // Darker, redder inside the nostrils.
-    let nostril = gauss(q, Vec3::new(7.5, -35.0, 96.5), 4.0);
+    let nostril = gauss(q, Vec3::new(8.5, -34.5, 95.0), 4.0);
     c = c.lerp(pal.flush * 0.6, (nostril * 1.5).min(0.7));
     // Eyebrows: streaky hairs along the arch.
     let brow = brow_mask(q);
@@ -1453,7 +1494,7 @@ fn pore_strength(region: u8) -> f32 {
 /// Pore mask (0..1, 1 at a pore's centre, weighted by region and faded out where a
 /// texel of `texel_mm` cannot resolve pores) and its gradient (1/mm).
 fn pores(p: Vec3, region: u8, texel_mm: f32, seed: u32) -> (f32, Vec3) {
-    let strength = pore_strength(region) * smoothstep(0.8, 2.5, PORE_CELL_MM / texel_mm.max(1e-3));
+    let strength = pore_strength(region) * smoothstep(0.6, 2.0, PORE_CELL_MM / texel_mm.max(1e-3));
     if strength <= 0.0 {
         return (0.0, Vec3::ZERO);
     }
@@ -1471,7 +1512,7 @@ fn pores(p: Vec3, region: u8, texel_mm: f32, seed: u32) -> (f32, Vec3) {
 }
 
 /// Tangent-space detail normal of a small height field (mm): pores 0.05 mm deep,
-/// micro relief, forehead lines, vertical lip furrows (amplitudes artistic). The slope
+/// micro relief (≈ 0.05 mm), forehead lines, vertical lip furrows (amplitudes artistic). The slope
 /// is taken along T and B; none on the eyeballs.
 fn detail_normal(
     p: Vec3,
@@ -1503,7 +1544,9 @@ fn detail_normal(
     let mut db = grad.dot(b);
     // Micro relief by differences over half a texel (filtered to what the map holds).
     let e = (0.5 * texel_mm).max(0.02);
-    let relief = |x: Vec3| 0.012 * fbm(x / 0.7, 2, seed ^ 0x1234);
+    let relief = |x: Vec3| {
+        0.05 * fbm(x / 2.0, 2, seed ^ 0x1234) + 0.01 * value_noise(x / 0.5, seed ^ 0x4321)
+    };
     let h0 = relief(p);
     dt += (relief(p + t * e) - h0) / e;
     db += (relief(p + b * e) - h0) / e;
@@ -1632,4 +1675,465 @@ fn par_chunks<T: Send>(data: &mut [T], chunk_len: usize, f: impl Fn(usize, &mut 
             });
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One default build shared by the tests (≈ 1 s in release).
+    fn head() -> &'static BuiltinHead {
+        static HEAD: OnceLock<BuiltinHead> = OnceLock::new();
+        HEAD.get_or_init(|| build_head(&HeadParams::default()))
+    }
+
+    /// Distance along `dir` from `from` to the first point inside the surface.
+    fn march_in(from: Vec3, dir: Vec3, max: f32) -> Option<f32> {
+        let mut t = 0.0;
+        while t < max {
+            if sdf(from + dir * t) < 0.0 {
+                return Some(t);
+            }
+            t += 0.02;
+        }
+        None
+    }
+
+    /// Thickness of the solid along its inward normal at the surface point hit by the
+    /// ray (`from`, `dir`).
+    fn thickness_along_normal(from: Vec3, dir: Vec3) -> f32 {
+        let hit = from + dir * march_in(from, dir, 100.0).expect("ray misses the head");
+        let n = sdf_and_gradient(hit).1.normalize();
+        let mut t = 0.0;
+        while t < 60.0 && sdf(hit - n * t) < 0.0 {
+            t += 0.02;
+        }
+        t
+    }
+
+    /// Chart id of every triangle: connected components through shared vertex ids
+    /// (vertices are duplicated per chart, so charts never share one).
+    fn chart_of_triangle(mesh: &Mesh) -> Vec<u32> {
+        let mut parent: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            for k in 1..3 {
+                let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
+                parent[a as usize] = b;
+            }
+        }
+        mesh.indices
+            .chunks_exact(3)
+            .map(|t| find(&mut parent, t[0]))
+            .collect()
+    }
+
+    fn uv_texels(mesh: &Mesh, t: &[u32], n: f32) -> [Vec2; 3] {
+        [t[0], t[1], t[2]].map(|i| mesh.uvs[i as usize] * n)
+    }
+
+    #[test]
+    fn mesh_is_valid_closed_and_sized() {
+        let h = head();
+        let m = &h.mesh;
+        m.validate().unwrap();
+        let tris = m.triangle_count();
+        assert!((20_000..=80_000).contains(&tris), "{tris} triangles");
+        // Weld by position: every directed edge must meet its reverse exactly as often
+        // (closed, consistently oriented surface before the UV split).
+        let mut id = std::collections::HashMap::new();
+        let weld: Vec<u32> = m
+            .positions
+            .iter()
+            .map(|p| {
+                let key = p.to_array().map(f32::to_bits);
+                let next = id.len() as u32;
+                *id.entry(key).or_insert(next)
+            })
+            .collect();
+        let mut edges = std::collections::HashMap::<(u32, u32), i32>::new();
+        for t in m.indices.chunks_exact(3) {
+            for k in 0..3 {
+                let (a, b) = (weld[t[k] as usize], weld[t[(k + 1) % 3] as usize]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+            }
+        }
+        let open = edges.values().filter(|&&v| v != 0).count();
+        assert_eq!(open, 0, "unmatched edges");
+        // Normals are unit and point outward (the field grows along them), except at
+        // the few vertices of sub-cell features where face normals stand in.
+        let mut inward = 0;
+        for (p, n) in m.positions.iter().zip(&m.normals) {
+            assert!((n.length() - 1.0).abs() < 1e-3);
+            inward += usize::from(sdf(*p + *n * 0.5) <= sdf(*p - *n * 0.5));
+        }
+        assert!(inward * 1000 < m.vertex_count(), "{inward} inward normals");
+    }
+
+    #[test]
+    fn dimensions_are_realistic() {
+        let (lo, hi) = head().mesh.bounds().unwrap();
+        let within = |v: f32, target: f32| (v - target).abs() <= 0.1 * target;
+        // Crown to chin ≈ 230 (chin: lowest point of the face at z = 80).
+        let chin = -150.0 + march_in(Vec3::new(0.0, -150.0, 80.0), Vec3::Y, 100.0).unwrap();
+        assert!(within(hi.y - chin, 230.0), "crown {} chin {chin}", hi.y);
+        // Head breadth ≈ 150 without the ears; ears stick out ≈ 5–15 mm further.
+        let h = head();
+        let breadth = h
+            .mesh
+            .positions
+            .iter()
+            .zip(&h.region_of_vertex)
+            .filter(|(_, &r)| r != REGION_EARS)
+            .fold(0.0f32, |m, (p, _)| m.max(p.x.abs()))
+            * 2.0;
+        assert!(within(breadth, 150.0), "breadth {breadth}");
+        assert!(hi.x - lo.x > breadth + 5.0 && hi.x - lo.x < 190.0);
+        // Length (nose tip to occiput) ≈ 195 … 215.
+        assert!(within(hi.z - lo.z, 195.0), "depth {}", hi.z - lo.z);
+        // Neck ≈ 110 wide, cut flat ≈ 100 mm below the chin.
+        let neck =
+            2.0 * (100.0 - march_in(Vec3::new(100.0, -170.0, -14.0), -Vec3::X, 100.0).unwrap());
+        assert!(within(neck, 110.0), "neck {neck}");
+        assert!(within(chin - lo.y, 100.0), "neck length {}", chin - lo.y);
+    }
+
+    #[test]
+    fn uvs_are_in_range_and_never_flipped_or_degenerate() {
+        let h = head();
+        let n = h.texture_size as f32;
+        assert!(h
+            .mesh
+            .uvs
+            .iter()
+            .all(|uv| uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all()));
+        let mut min_area = f32::MAX;
+        for t in h.mesh.indices.chunks_exact(3) {
+            let uv = uv_texels(&h.mesh, t, n);
+            // All charts keep one winding: negative signed area with v down.
+            let area = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+            assert!(area < 0.0, "flipped UV triangle");
+            min_area = min_area.min(-area);
+        }
+        assert!(min_area > 1e-5, "degenerate UV triangle: {min_area} texel²");
+    }
+
+    #[test]
+    fn charts_do_not_overlap_and_keep_a_gutter() {
+        let h = head();
+        let n = h.texture_size as usize;
+        let chart = chart_of_triangle(&h.mesh);
+        let mut owner = vec![u32::MAX; n * n];
+        let mut overlaps = 0;
+        for (t, c) in h.mesh.indices.chunks_exact(3).zip(&chart) {
+            raster_triangle(&uv_texels(&h.mesh, t, n as f32), n, n, 1e-3, |x, y, _| {
+                let o = &mut owner[y * n + x];
+                if *o != u32::MAX {
+                    overlaps += 1; // two triangles (same or other chart) on one texel
+                }
+                *o = *c;
+            });
+        }
+        assert_eq!(overlaps, 0);
+        // At least 8 empty texels between texels of different charts.
+        for y in 0..n {
+            for x in 0..n {
+                let c = owner[y * n + x];
+                if c == u32::MAX {
+                    continue;
+                }
+                for yy in y.saturating_sub(8)..(y + 9).min(n) {
+                    for xx in x.saturating_sub(8)..(x + 9).min(n) {
+                        let o = owner[yy * n + xx];
+                        assert!(o == u32::MAX || o == c, "gutter < 8 texels at ({x}, {y})");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn atlas_has_seams_and_real_stretch() {
+        let h = head();
+        let m = &h.mesh;
+        // Seams: the same position appears with different UVs.
+        let mut by_pos = std::collections::HashMap::<[u32; 3], Vec2>::new();
+        let mut seams = 0;
+        for (p, uv) in m.positions.iter().zip(&m.uvs) {
+            let key = p.to_array().map(f32::to_bits);
+            match by_pos.get(&key) {
+                Some(prev) if *prev != *uv => seams += 1,
+                Some(_) => {}
+                None => {
+                    by_pos.insert(key, *uv);
+                }
+            }
+        }
+        assert!(seams > 200, "{seams} seam vertices");
+        assert!(h.chart_count >= 6);
+        // Stretch over the face chart (the chart of the mid-forehead): mm per texel
+        // varies with the slant of the surface.
+        let chart = chart_of_triangle(m);
+        let n = h.texture_size as f32;
+        let forehead = Vec3::new(0.0, 50.0, 88.0);
+        let tip = m
+            .indices
+            .chunks_exact(3)
+            .map(|t| (m.positions[t[0] as usize] - forehead).length())
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap()
+            .0;
+        let mut ratio: Vec<f32> = m
+            .indices
+            .chunks_exact(3)
+            .zip(&chart)
+            .filter(|(_, &c)| c == chart[tip])
+            .map(|(t, _)| {
+                let p = [t[0], t[1], t[2]].map(|i| m.positions[i as usize]);
+                let uv = uv_texels(m, t, n);
+                let a3 = (p[1] - p[0]).cross(p[2] - p[0]).length();
+                let a2 = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+                (a3 / a2).sqrt()
+            })
+            .collect();
+        assert!(
+            ratio.len() > 5000,
+            "face chart has {} triangles",
+            ratio.len()
+        );
+        ratio.sort_by(f32::total_cmp);
+        let (p2, p98) = (ratio[ratio.len() / 50], ratio[ratio.len() * 49 / 50]);
+        assert!(p98 / p2 > 1.3, "stretch range {p2}..{p98} mm/texel");
+        assert!((p2 - h.mm_per_texel).abs() < 0.1 * h.mm_per_texel);
+    }
+
+    #[test]
+    fn tangents_are_orthonormal_and_consistently_handed() {
+        let m = &head().mesh;
+        let w0 = m.tangents[0].w;
+        for (t, n) in m.tangents.iter().zip(&m.normals) {
+            assert!((t.truncate().length() - 1.0).abs() < 1e-3);
+            assert!(t.truncate().dot(*n).abs() < 1e-3);
+            assert_eq!(t.w, w0);
+        }
+    }
+
+    #[test]
+    fn eye_sockets_are_recessed() {
+        let z = |x: f32, y: f32| 150.0 - march_in(Vec3::new(x, y, 150.0), -Vec3::Z, 200.0).unwrap();
+        let (brow, brow_lateral, cheekbone) = (z(31.5, 24.0), z(44.0, 22.0), z(44.0, -14.0));
+        let (lid_crease, lateral_canthus) = (z(31.5, 13.0), z(46.0, 4.0));
+        assert!(lid_crease < brow - 5.0, "lid {lid_crease} brow {brow}");
+        assert!(lateral_canthus < brow_lateral - 5.0);
+        assert!(
+            lateral_canthus < cheekbone - 3.0,
+            "canthus {lateral_canthus} cheek {cheekbone}"
+        );
+        // The eyeballs are in the sockets: the cornea stays behind the brow.
+        assert!(z(31.5, 3.0) < brow - 4.0);
+        assert!(sdf(EYE_CENTRE) < 0.0 && sdf(EYE_CENTRE * Vec3::new(-1.0, 1.0, 1.0)) < 0.0);
+    }
+
+    #[test]
+    fn nostrils_are_open_cavities() {
+        for s in [1.0, -1.0] {
+            let inside = Vec3::new(8.5 * s, -34.5, 95.0);
+            assert!(sdf(inside) > 0.0, "no nostril cavity");
+            // Surrounded by tissue above, laterally (ala) and medially (columella)…
+            assert!(sdf(Vec3::new(7.5 * s, -29.0, 96.0)) < 0.0);
+            assert!(sdf(Vec3::new(14.0 * s, -35.0, 95.0)) < 0.0);
+            assert!(sdf(Vec3::new(0.0, -35.0, 98.0)) < 0.0);
+            // …and open to the outside below.
+            let mut y = -35.0;
+            while y > -45.0 {
+                assert!(sdf(Vec3::new(7.5 * s, y, 96.0)) > 0.0, "closed at y = {y}");
+                y -= 0.25;
+            }
+        }
+    }
+
+    #[test]
+    fn ears_have_folds_and_a_gap_behind() {
+        let f = ear_frame();
+        let world = |l: Vec3| f.centre + f.out * l.x + f.up * l.y + f.fwd * l.z;
+        let depth = |ly: f32, lz: f32| {
+            30.0 - march_in(world(Vec3::new(30.0, ly, lz)), -f.out, 60.0).unwrap()
+        };
+        // The concha is a bowl: deeper than the helix rim and the antihelix.
+        let (concha, helix, antihelix) = (depth(-4.0, 5.0), depth(0.0, -15.0), depth(4.0, -10.5));
+        assert!(concha < helix - 4.0, "concha {concha} helix {helix}");
+        assert!(
+            concha < antihelix - 2.0,
+            "concha {concha} antihelix {antihelix}"
+        );
+        // Behind the back of the auricle there is air, then the head.
+        let start = world(Vec3::new(30.0, 0.0, -13.0));
+        let enter = march_in(start, -f.out, 60.0).unwrap();
+        let mut t = enter;
+        while sdf(start - f.out * t) < 0.0 {
+            t += 0.02;
+        }
+        let exit = t;
+        let reenter = exit + march_in(start - f.out * exit, -f.out, 60.0).unwrap();
+        assert!(
+            reenter - exit > 2.0,
+            "no gap behind the ear ({})",
+            reenter - exit
+        );
+        // Mirror image on the right.
+        assert!((sdf(start) - sdf(start * Vec3::new(-1.0, 1.0, 1.0))).abs() < 1e-4);
+    }
+
+    #[test]
+    fn ears_and_nose_wings_are_thin() {
+        let f = ear_frame();
+        let world = |l: Vec3| f.centre + f.out * l.x + f.up * l.y + f.fwd * l.z;
+        for (ly, lz) in [(14.0, -8.0), (20.0, -10.7), (0.0, -15.0)] {
+            let t = thickness_along_normal(world(Vec3::new(30.0, ly, lz)), -f.out);
+            assert!(t > 2.5 && t < 8.0, "ear thickness {t} mm at ({ly}, {lz})");
+        }
+        let ala = thickness_along_normal(Vec3::new(40.0, -34.5, 94.0), -Vec3::X);
+        assert!(ala > 1.5 && ala < 8.0, "alar wall {ala} mm");
+    }
+
+    #[test]
+    fn albedo_is_skin_with_redder_lips() {
+        let h = head();
+        let n = h.texture_size as usize;
+        let mut covered = vec![false; n * n];
+        for t in h.mesh.indices.chunks_exact(3) {
+            raster_triangle(&uv_texels(&h.mesh, t, n as f32), n, n, 1e-3, |x, y, _| {
+                covered[y * n + x] = true
+            });
+        }
+        let mut sums = [(0.0f64, 0usize); REGION_COUNT];
+        for (i, &inside) in covered.iter().enumerate() {
+            let a = &h.albedo_srgb[i * 4..i * 4 + 4];
+            assert_eq!(a[3], 255);
+            assert!(a[0] > 2 || a[1] > 2 || a[2] > 2, "black texel {i}");
+            let r = h.regions[i * 4];
+            assert!((r as usize) < REGION_COUNT);
+            if inside {
+                let s = &mut sums[r as usize];
+                s.0 += f64::from(a[0]) / f64::from(a[1].max(1));
+                s.1 += 1;
+            }
+        }
+        let mean = |r: u8| sums[r as usize].0 / sums[r as usize].1.max(1) as f64;
+        let cheek = mean(REGION_LEFT_CHEEK).max(mean(REGION_RIGHT_CHEEK));
+        assert!(
+            mean(REGION_LOWER_LIP) > cheek + 0.1,
+            "lip r/g {} cheek {cheek}",
+            mean(REGION_LOWER_LIP)
+        );
+        assert!(mean(REGION_UPPER_LIP) > cheek);
+        for (r, s) in sums.iter().enumerate() {
+            assert!(s.1 > 100, "region {} has {} texels", REGION_NAMES[r], s.1);
+        }
+    }
+
+    #[test]
+    fn detail_normals_are_unit_and_face_out() {
+        let h = head();
+        let n = h.texture_size as usize;
+        let mut covered = vec![false; n * n];
+        for t in h.mesh.indices.chunks_exact(3) {
+            raster_triangle(&uv_texels(&h.mesh, t, n as f32), n, n, 1e-3, |x, y, _| {
+                covered[y * n + x] = true
+            });
+        }
+        let mut bumped = 0;
+        for (px, &inside) in h.normal_detail.chunks_exact(4).zip(&covered) {
+            let v = Vec3::new(px[0] as f32, px[1] as f32, px[2] as f32) / 127.5 - Vec3::ONE;
+            assert!(v.z > 0.0, "{v}");
+            if inside {
+                // 8-bit quantisation allows ≈ 1 % error; gutters hold averages.
+                assert!((v.length() - 1.0).abs() < 0.02, "{v}");
+                // Tilted by more than ≈ 1.5 quantisation steps.
+                bumped += usize::from(v.x.abs().max(v.y.abs()) > 0.012);
+            }
+        }
+        let total = covered.iter().filter(|&&c| c).count();
+        assert!(
+            bumped * 4 > total,
+            "only {bumped} of {total} texels carry detail"
+        );
+    }
+
+    #[test]
+    fn base_skin_tone_is_intermediate_by_ita() {
+        // Individual typology angle (Chardon et al. 1991): 28° < ITA ≤ 41° is
+        // "intermediate" skin.
+        let c = Palette::new().skin;
+        let y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        let z = (0.0193 * c.x + 0.1192 * c.y + 0.9505 * c.z) / 1.089;
+        let f = |t: f32| t.cbrt();
+        let l_star = 116.0 * f(y) - 16.0;
+        let b_star = 200.0 * (f(y) - f(z));
+        let ita = ((l_star - 50.0) / b_star).atan().to_degrees();
+        assert!(ita > 28.0 && ita <= 41.0, "ITA {ita}");
+    }
+
+    #[test]
+    fn regions_cover_the_face() {
+        let h = head();
+        let mut seen = [0usize; REGION_COUNT];
+        for &r in &h.region_of_vertex {
+            seen[r as usize] += 1;
+        }
+        assert!(seen.iter().all(|&c| c > 20), "{seen:?}");
+        assert_eq!(region_at(Vec3::new(0.0, -28.0, 112.0)), REGION_NOSE);
+        assert_eq!(region_at(Vec3::new(40.0, -25.0, 75.0)), REGION_LEFT_CHEEK);
+        assert_eq!(region_at(Vec3::new(-40.0, -25.0, 75.0)), REGION_RIGHT_CHEEK);
+        assert_eq!(region_at(Vec3::new(0.0, 50.0, 85.0)), REGION_FOREHEAD);
+        assert_eq!(region_at(Vec3::new(0.0, -95.0, 90.0)), REGION_CHIN);
+        assert_eq!(region_at(Vec3::new(0.0, 0.0, -95.0)), REGION_OTHER);
+    }
+
+    #[test]
+    fn build_is_deterministic_and_fast() {
+        let t = std::time::Instant::now();
+        let b = build_head(&HeadParams::default());
+        let secs = t.elapsed().as_secs_f32();
+        eprintln!("built-in head built in {secs:.2} s");
+        let a = head();
+        assert_eq!(a.mesh.positions, b.mesh.positions);
+        assert_eq!(a.mesh.uvs, b.mesh.uvs);
+        assert_eq!(a.mesh.indices, b.mesh.indices);
+        assert_eq!(a.mesh.tangents, b.mesh.tangents);
+        assert!(a.albedo_srgb == b.albedo_srgb);
+        assert!(a.normal_detail == b.normal_detail);
+        assert!(a.regions == b.regions);
+        // Generous bound (shared CI machines); ≈ 1 s measured on 2 cores.
+        #[cfg(not(debug_assertions))]
+        assert!(secs < 10.0, "{secs} s");
+    }
+
+    #[test]
+    fn other_seeds_and_sizes_work() {
+        let h = build_head(&HeadParams {
+            grid_mm: 4.0,
+            texture_size: 256,
+            seed: 7,
+        });
+        h.mesh.validate().unwrap();
+        assert_eq!(h.albedo_srgb.len(), 256 * 256 * 4);
+        assert_eq!(h.normal_detail.len(), 256 * 256 * 4);
+        assert_eq!(h.regions.len(), 256 * 256 * 4);
+        assert_eq!(h.region_of_vertex.len(), h.mesh.vertex_count());
+        let odd = build_head(&HeadParams {
+            grid_mm: f32::NAN,
+            texture_size: 0,
+            seed: 0,
+        });
+        assert_eq!(odd.texture_size, 64);
+        odd.mesh.validate().unwrap();
+    }
 }
