@@ -215,11 +215,6 @@ impl Context {
             .optimal_tiling_features
             .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
     }
-
-    pub fn wait_idle(&self) -> Result<()> {
-        let _queue = self.queue();
-        unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")
-    }
 }
 
 impl Drop for Context {

@@ -12,8 +12,3 @@ pub fn spirv(name: &str) -> Result<&'static [u32]> {
         .map(|(_, words)| *words)
         .ok_or_else(|| Error::Graph(format!("no embedded shader named {name:?}")))
 }
-
-/// Names of every embedded shader.
-pub fn names() -> impl Iterator<Item = &'static str> {
-    SHADERS.iter().map(|(n, _)| *n)
-}

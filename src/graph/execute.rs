@@ -448,10 +448,6 @@ impl Executor {
         Ok(ex)
     }
 
-    pub fn clock(&self) -> Clock {
-        self.clock
-    }
-
     /// Overrides the automatic choice; `GpuTimestamp` needs device timestamps.
     pub fn set_clock(&mut self, clock: Clock) -> Result<()> {
         if clock == Clock::GpuTimestamp && !self.ctx.info.timestamps {

@@ -185,10 +185,6 @@ impl Graph {
             },
         }
     }
-
-    pub fn pass_count(&self) -> usize {
-        self.passes.len()
-    }
 }
 
 pub struct PassBuilder<'g> {
