@@ -11,6 +11,6 @@ void main() {
     vec2 ndc = gl_FragCoord.xy / pc.size * 2.0 - 1.0;
     vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 dir = far.xyz / far.w - frame.camera_pos.xyz;
-    vec3 radiance = texture(env_tex, equirect_uv(env_dir(dir, frame.env.x))).rgb;
+    vec3 radiance = textureLod(env_tex, equirect_uv(env_dir(dir, frame.env.x)), 0.0).rgb;
     color = vec4(radiance * frame.env.y, 1.0);
 }

@@ -1,5 +1,5 @@
 #version 460
-// Diffuse shading of the mesh: albedo/π × (SH environment irradiance + directional
+// Diffuse shading of the mesh: albedo/π × (SH environment irradiance + explicit
 // lights), with the tangent-space normal map. Replaced by texture-space diffusion
 // in the skin passes; kept as the `diffuse-direct` view.
 #extension GL_GOOGLE_include_directive : require
@@ -18,6 +18,8 @@ layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
+#define SHADOW_ATLAS 5
+#include "lights.glsl"
 #include "lighting.glsl"
 layout(location = 0) out vec4 color;
 
@@ -32,7 +34,7 @@ vec3 shading_normal() {
 
 void main() {
     vec3 n = shading_normal();
-    vec3 e = irradiance_at(n, vec2(0.0));
+    vec3 e = irradiance_at(v_position, v_normal, n, vec2(0.0));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     color = vec4(albedo / PI_F * e, 1.0);
 }

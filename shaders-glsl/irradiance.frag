@@ -1,6 +1,6 @@
 #version 460
 // Irradiance in texture space (GPU Gems 3 §14.5): SH environment irradiance
-// (Ramamoorthi & Hanrahan 2001) plus directional lights, times the pre-scatter
+// (Ramamoorthi & Hanrahan 2001) plus the explicit lights (shadowed), times the pre-scatter
 // albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
@@ -26,13 +26,15 @@ layout(location = 6) in vec3 v_t678;
 #define SPEC_PARAMS 10
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
+#define SHADOW_ATLAS 11
+#include "lights.glsl"
 #define ENERGY_CONSERVING_LIGHTS
 #include "lighting.glsl"
 layout(location = 0) out vec4 irradiance;
 
 void main() {
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-    vec3 e = irradiance_at(n, specular_params(v_uv, pc.roughness_map != 0u));
+    vec3 e = irradiance_at(v_position, v_normal, n, specular_params(v_uv, pc.roughness_map != 0u));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
 }

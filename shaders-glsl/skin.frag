@@ -2,22 +2,30 @@
 // Final skin shading (GPU Gems 3 §14.5; the paper's Fig. 2): the diffusion
 // profile as Σ w_i · blur_i, each blur normalised by its coverage, times the
 // post-scatter albedo^(1-mix); Lambert's 1/π turns irradiance into radiance.
+// Plus the KS specular (the paper's eq. 1) of the explicit lights and of the
+// environment (split sum: ρs·A(N·V, m) × the KS-prefiltered environment).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
+#include "envmap.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
-layout(binding = 2) uniform sampler2D blur1;
-layout(binding = 3) uniform sampler2D blur2;
-layout(binding = 4) uniform sampler2D blur3;
-layout(binding = 5) uniform sampler2D blur4;
-layout(binding = 6) uniform sampler2D blur5;
-layout(binding = 7) uniform sampler2D blur6;
-layout(binding = 8) uniform sampler2D normal_tex;
-#define SPEC_BECKMANN 9
-#define SPEC_ALBEDO 10
-#define SPEC_REGIONS 11
-#define SPEC_INTENSITY 12
-#define SPEC_ROUGHNESS 13
-#define SPEC_PARAMS 14
+layout(binding = 2) uniform sampler2D normal_tex;
+#define SHADOW_ATLAS 3
+#include "lights.glsl"
+// binding 4: the per-vertex transfer, read by mesh_lit.vert.
+#define ENV_SPECULAR 5
+#include "env_specular.glsl"
+layout(binding = 6) uniform sampler2D blur1;
+layout(binding = 7) uniform sampler2D blur2;
+layout(binding = 8) uniform sampler2D blur3;
+layout(binding = 9) uniform sampler2D blur4;
+layout(binding = 10) uniform sampler2D blur5;
+layout(binding = 11) uniform sampler2D blur6;
+#define SPEC_BECKMANN 12
+#define SPEC_ALBEDO 13
+#define SPEC_REGIONS 14
+#define SPEC_INTENSITY 15
+#define SPEC_ROUGHNESS 16
+#define SPEC_PARAMS 17
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 // mode: 0 final, 1 diffuse only, 2 specular only.
@@ -26,9 +34,10 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_tangent;
+layout(location = 4) in vec3 v_t012;
+layout(location = 5) in vec3 v_t345;
+layout(location = 6) in vec3 v_t678;
 layout(location = 0) out vec4 color;
-
-const float PI = 3.14159265358979;
 
 vec3 level(sampler2D t, int i) {
     vec4 b = texture(t, v_uv);
@@ -45,11 +54,19 @@ void main() {
     vec2 params = specular_params(v_uv, pc.roughness_map != 0u);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     // Light leaving the skin loses what the oil layer reflects toward the viewer.
+    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI
-             * diffuse_transmission(dot(n, v), params);
+             * diffuse_transmission(n_dot_v, params);
     vec3 spec = vec3(0.0);
     for (int i = 0; i < int(frame.env.z); ++i) {
-        spec += frame.light_color[i].rgb * ks_specular(n, frame.light_dir[i].xyz, v, params);
+        vec3 l;
+        vec3 e = light_irradiance(i, v_position, v_normal, l);
+        spec += e * ks_specular(n, l, v, params);
     }
+    // The environment's share: occluded like the diffuse by the transfer's
+    // visibility (its DC term relative to open sky; 1 without occlusion).
+    float visibility = frame.env.w > 0.5 ? clamp(v_t012.x / (PI * 0.282095), 0.0, 1.0) : 1.0;
+    spec += params.x * specular_albedo(n_dot_v, params.y)
+          * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);
 }

@@ -14,3 +14,10 @@ vec3 env_dir(vec3 d, float angle) {
     float c = cos(angle), s = sin(angle);
     return vec3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
 }
+
+// The inverse of equirect_uv.
+vec3 equirect_dir(vec2 uv) {
+    float theta = uv.y * PI;
+    float phi = (uv.x - 0.5) * 2.0 * PI;
+    return vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+}

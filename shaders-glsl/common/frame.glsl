@@ -3,8 +3,9 @@ layout(std140, binding = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
     vec4 camera_pos;        // xyz mm
-    vec4 light_dir[4];      // xyz: direction towards the light
-    vec4 light_color[4];    // rgb: irradiance on a surface facing it
+    vec4 light_vec[4];      // w 0: xyz direction towards the light; w 1: xyz position, mm
+    vec4 light_color[4];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
+    mat4 light_shadow[4];   // world → (atlas u, v, depth) after the divide by w
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on
     vec4 params;            // x: exposure (EV)
 } frame;

@@ -7,6 +7,7 @@
 //   SPEC_INTENSITY sampler2D  ρs scale (the specular map)
 //   SPEC_ROUGHNESS sampler2D  m (grey), used when roughness_map != 0
 //   SPEC_PARAMS    buffer     per region (ρs, m)
+#include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
 layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
 layout(binding = SPEC_REGIONS) uniform sampler2D region_tex;
@@ -20,7 +21,6 @@ vec2 table_uv(sampler2D table, vec2 x) {
     return (clamp(x, 0.0, 1.0) * (n - 1.0) + 0.5) / n;
 }
 
-const float F0_SKIN = 0.028;   // Schlick F0 of skin's oil layer (n ≈ 1.4), GPU Gems 3 §14.3
 const float REGION_BLEND_TEXELS = 4.0;   // region borders blend over ±8 texels
 
 // (ρs, m) at uv: region parameters blended with tent weights over a 3×3 grid of
@@ -46,11 +46,6 @@ vec2 specular_params(vec2 uv, bool roughness_map) {
     return params;
 }
 
-float fresnel_schlick(float h_dot_v, float f0) {
-    float base = 1.0 - h_dot_v;
-    return f0 + (1.0 - f0) * base * base * base * base * base;
-}
-
 // N·L · ρs · D·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h) stands for
 // the microfacet denominator); D from the Beckmann table.
 float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
@@ -63,8 +58,13 @@ float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
     return n_dot_l * params.x * max(d * f / dot(h, h), 0.0);
 }
 
+// Directional albedo of the KS lobe with ρs = 1, A(cos θ, m) (skin/specular.rs).
+float specular_albedo(float cos_theta, float m) {
+    return texture(albedo_lut, table_uv(albedo_lut, vec2(cos_theta, m))).r;
+}
+
 // Energy conservation: the share of light at angle θ the specular does not take,
 // 1 − ρs·A(cos θ, m) (GPU Gems 3 §14.3).
 float diffuse_transmission(float cos_theta, vec2 params) {
-    return 1.0 - params.x * texture(albedo_lut, table_uv(albedo_lut, vec2(cos_theta, params.y))).r;
+    return 1.0 - params.x * specular_albedo(cos_theta, params.y);
 }

@@ -1,10 +1,11 @@
 // Diffuse irradiance at a surface point: the environment through SH — with
 // occlusion, E = Σ L_i·T_i from the interpolated per-vertex transfer (the paper's
 // eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
-// directional lights. Needs frame.glsl, sh.glsl, the Lighting buffer and v_t*.
+// explicit lights at x (geometric normal ng). Needs frame.glsl, sh.glsl,
+// lights.glsl, the Lighting buffer and v_t*.
 // With ENERGY_CONSERVING_LIGHTS (and ks_specular.glsl), each light is scaled by
 // 1 − ρs·A(N·L, m): what the specular reflects does not enter the skin.
-vec3 irradiance_at(vec3 n, vec2 spec_params) {
+vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
     vec3 e;
     if (frame.env.w > 0.5) {
         float t[9] = float[9](v_t012.x, v_t012.y, v_t012.z, v_t345.x, v_t345.y, v_t345.z,
@@ -16,11 +17,13 @@ vec3 irradiance_at(vec3 n, vec2 spec_params) {
     }
     e = max(e, vec3(0.0));
     for (int i = 0; i < int(frame.env.z); ++i) {
-        float n_dot_l = max(dot(n, frame.light_dir[i].xyz), 0.0);
+        vec3 l;
+        vec3 e_light = light_irradiance(i, x, ng, l);
+        float n_dot_l = max(dot(n, l), 0.0);
 #ifdef ENERGY_CONSERVING_LIGHTS
         n_dot_l *= diffuse_transmission(n_dot_l, spec_params);
 #endif
-        e += frame.light_color[i].rgb * n_dot_l;
+        e += e_light * n_dot_l;
     }
     return e;
 }

@@ -244,6 +244,17 @@ pub struct Sampler {
 impl Sampler {
     /// Clamp-to-edge sampler; `linear` picks bilinear filtering, else nearest.
     pub fn clamped(ctx: &Arc<Context>, linear: bool) -> Result<Self> {
+        Self::new(ctx, linear, None)
+    }
+
+    /// A depth-comparison sampler for shadow maps: `texture(sampler2DShadow,
+    /// (uv, ref))` returns 1 where ref ≤ the stored depth; `linear` filters the
+    /// four comparisons bilinearly.
+    pub fn shadow(ctx: &Arc<Context>, linear: bool) -> Result<Self> {
+        Self::new(ctx, linear, Some(vk::CompareOp::LESS_OR_EQUAL))
+    }
+
+    fn new(ctx: &Arc<Context>, linear: bool, compare: Option<vk::CompareOp>) -> Result<Self> {
         let filter = if linear {
             vk::Filter::LINEAR
         } else {
@@ -256,7 +267,9 @@ impl Sampler {
             .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(vk::LOD_CLAMP_NONE);
+            .max_lod(vk::LOD_CLAMP_NONE)
+            .compare_enable(compare.is_some())
+            .compare_op(compare.unwrap_or(vk::CompareOp::NEVER));
         let raw = unsafe { ctx.device.create_sampler(&info, None) }.vk("vkCreateSampler")?;
         Ok(Self {
             ctx: ctx.clone(),

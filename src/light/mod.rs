@@ -4,8 +4,10 @@
 pub mod envmap;
 pub mod occlusion;
 pub mod occlusion_raster;
+pub mod prefilter;
 pub mod sh;
 pub mod sh_pass;
+pub mod shadow;
 pub mod sky;
 
 use crate::error::Result;

@@ -1,5 +1,5 @@
 //! Screen-space scene passes: the environment behind the head, and the mesh with
-//! direct diffuse shading (the `diffuse-direct` path until the skin passes land).
+//! direct diffuse shading (`--view direct`) or its occlusion (`--view occlusion`).
 
 use super::resources::{MeshBuffers, Samplers, Vertex, VERTEX_ATTRIBUTES};
 use crate::error::Result;
@@ -19,9 +19,15 @@ pub struct FrameUniforms {
     pub view_proj: [[f32; 4]; 4],
     pub inv_view_proj: [[f32; 4]; 4],
     pub camera_pos: [f32; 4],
-    pub light_dir: [[f32; 4]; 4],
+    /// w = 0: direction towards the light; w = 1: position, mm.
+    pub light_vec: [[f32; 4]; 4],
+    /// rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel
+    /// size, mm (per mm of distance for a point light), 0 = unshadowed.
     pub light_color: [[f32; 4]; 4],
-    /// x: environment rotation (radians about +Y), y: intensity, z: light count.
+    /// World to (atlas u, v, depth), light::shadow::ShadowView::atlas_matrix.
+    pub light_shadow: [[[f32; 4]; 4]; 4],
+    /// x: environment rotation (radians about +Y), y: intensity, z: light count,
+    /// w: occlusion on.
     pub env: [f32; 4],
     /// x: exposure (EV).
     pub params: [f32; 4],
@@ -64,6 +70,7 @@ impl ForwardPipelines {
                         Binding::SampledImage,
                         Binding::StorageBuffer,
                         Binding::StorageBuffer,
+                        Binding::SampledImage,
                     ],
                     push_constant_bytes: 0,
                     color_formats: &[HDR_FORMAT],
@@ -155,19 +162,22 @@ pub fn background(
 }
 
 /// The mesh drawn in screen space over `hdr` with `pipeline` (`direct` or
-/// `occlusion` of [`ForwardPipelines`]); `sh`: the environment's coefficients.
+/// `occlusion` of [`ForwardPipelines`]); `sh`: the environment's coefficients;
+/// `shadows`: the lights' shadow atlas (light::shadow).
 pub fn direct(
     g: &mut Graph,
     pipeline: &Arc<Pipeline>,
     name: &str,
     inputs: &Arc<ForwardInputs>,
     sh: &BufferHandle,
+    shadows: &ImageHandle,
     hdr: &mut ImageHandle,
 ) {
     let (w, h) = (hdr.desc.width, hdr.desc.height);
     let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
     let mut pass = g.add_pass(name);
     let coeffs = pass.read_buffer(sh, Access::FragmentBufferRead);
+    let atlas = pass.read(shadows, Access::FragmentSampled);
     pass.color_attachment(hdr, LoadOp::Load);
     pass.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
     let (pipe, inp) = (pipeline.clone(), inputs.clone());
@@ -181,6 +191,7 @@ pub fn direct(
                 Descriptor::StaticSampled(&inp.normal, &inp.samplers.linear),
                 Descriptor::Storage(coeffs),
                 Descriptor::StaticStorage(&inp.transfer),
+                Descriptor::Sampled(atlas, &inp.samplers.shadow),
             ],
         );
         inp.mesh.draw(cx);

@@ -11,14 +11,16 @@ use crate::graph::upload::readback_pass;
 use crate::graph::upload::upload_buffer;
 use crate::graph::ImageHandle;
 use crate::graph::{Access, Executor, Graph};
+use crate::light::prefilter::{self, PrefilterPass};
 use crate::light::sh_pass::{ShBuffers, ShPasses};
+use crate::light::shadow::{ShadowPass, ShadowView};
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::profile::RunReport;
 use crate::scene::file::{Occlusion, SceneFile};
-use crate::scene::Scene;
+use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::irradiance::IrradiancePass;
-use crate::skin::shade::{ShadeMode, ShadePass, ShadeSettings};
+use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::stretch::StretchPass;
 use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
@@ -45,6 +47,9 @@ pub enum View {
     Stretch,
     /// UV-space blur level 1..=6 (as stored).
     Blur(u8),
+    /// The KS-prefiltered environment: its roughness levels stacked top to bottom
+    /// (light::prefilter).
+    Prefiltered,
 }
 
 impl View {
@@ -57,20 +62,34 @@ impl View {
             "occlusion" => View::Occlusion,
             "irradiance" => View::Irradiance,
             "stretch" => View::Stretch,
+            "prefiltered" => View::Prefiltered,
             _ => match s.strip_prefix("blur").and_then(|k| k.parse::<u8>().ok()) {
                 Some(k @ 1..=6) => View::Blur(k),
                 _ => {
                     return Err(Error::Input(format!(
-                    "unknown view {s:?}: final, diffuse, specular, direct, occlusion, irradiance, stretch, blur1..blur6"
+                    "unknown view {s:?}: final, diffuse, specular, direct, occlusion, irradiance, stretch, blur1..blur6, prefiltered"
                 )))
                 }
             },
         })
     }
 
-    /// Whether the view is a UV-space target (written at irradiance resolution).
+    /// Whether the view is an intermediate texture rather than a screen image:
+    /// read back as stored, without tone mapping.
     pub fn uv_space(self) -> bool {
-        matches!(self, View::Irradiance | View::Stretch | View::Blur(_))
+        matches!(
+            self,
+            View::Irradiance | View::Stretch | View::Blur(_) | View::Prefiltered
+        )
+    }
+
+    /// The size of the image the view reads back.
+    fn size(self, screen: (u32, u32), irradiance_resolution: u32) -> (u32, u32) {
+        match self {
+            View::Prefiltered => (prefilter::WIDTH, prefilter::HEIGHT * prefilter::LEVELS),
+            v if v.uv_space() => (irradiance_resolution, irradiance_resolution),
+            _ => screen,
+        }
     }
 }
 
@@ -129,7 +148,40 @@ pub fn render(opts: &RenderOptions) -> Result<RenderOutput> {
     render_scene(&ctx, &scene, opts)
 }
 
-/// The frame's uniforms: camera, environment rotation and intensity, lights, exposure.
+/// The shadow projection of each light the frame uses (`None`: unshadowed).
+fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
+    let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
+    let (centre, radius) = (0.5 * (lo + hi), 0.5 * lo.distance(hi));
+    let res = scene.file.render.shadow_resolution;
+    if scene.lights.len() > MAX_LIGHTS {
+        log::warn!(
+            "only the first {MAX_LIGHTS} of {} lights are used",
+            scene.lights.len()
+        );
+    }
+    scene
+        .lights
+        .iter()
+        .take(MAX_LIGHTS)
+        .map(|l| {
+            let view = l
+                .shadow
+                .then(|| ShadowView::fit(l.source, centre, radius, res))
+                .flatten();
+            if l.shadow && view.is_none() {
+                log::warn!(
+                    "{:?} is inside the mesh's bounding sphere (radius {radius:.0} mm): \
+                     one shadow map cannot hold every direction; it casts no shadow",
+                    l.source
+                );
+            }
+            view
+        })
+        .collect()
+}
+
+/// The frame's uniforms: camera, environment rotation and intensity, lights and
+/// their shadow projections, exposure.
 pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let env = &scene.file.environment;
@@ -137,8 +189,9 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
         view_proj: vp.to_cols_array_2d(),
         inv_view_proj: vp.inverse().to_cols_array_2d(),
         camera_pos: scene.camera.position.extend(1.0).into(),
-        light_dir: [[0.0; 4]; MAX_LIGHTS],
+        light_vec: [[0.0; 4]; MAX_LIGHTS],
         light_color: [[0.0; 4]; MAX_LIGHTS],
+        light_shadow: [[[0.0; 4]; 4]; MAX_LIGHTS],
         env: [
             env.rotation_deg.to_radians(),
             env.intensity,
@@ -151,15 +204,21 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
         ],
         params: [scene.exposure(), 0.0, 0.0, 0.0],
     };
-    if scene.lights.len() > MAX_LIGHTS {
-        log::warn!(
-            "only the first {MAX_LIGHTS} of {} lights are used",
-            scene.lights.len()
-        );
-    }
-    for (i, l) in scene.lights.iter().take(MAX_LIGHTS).enumerate() {
-        u.light_dir[i] = l.direction.extend(0.0).into();
+    let views = shadow_views(scene);
+    let tiles = views.iter().flatten().count();
+    let mut tile = 0;
+    for (i, (l, view)) in scene.lights.iter().zip(&views).enumerate() {
+        u.light_vec[i] = match l.source {
+            LightSource::Directional(d) => d.extend(0.0),
+            LightSource::Point(p) => p.extend(1.0),
+        }
+        .into();
         u.light_color[i] = l.irradiance.extend(0.0).into();
+        if let Some(v) = view {
+            u.light_color[i][3] = v.texel_mm;
+            u.light_shadow[i] = v.atlas_matrix(tile, tiles).to_cols_array_2d();
+            tile += 1;
+        }
         u.env[2] = (i + 1) as f32;
     }
     u
@@ -173,6 +232,11 @@ struct Frame {
     irradiance: IrradiancePass,
     blur: BlurChain,
     shade: ShadePass,
+    shadow: ShadowPass,
+    /// The shadowed lights' projections, in atlas tile order.
+    shadow_views: Vec<ShadowView>,
+    shadow_resolution: u32,
+    prefilter: PrefilterPass,
     tonemap: Tonemap,
     sh: ShPasses,
     sh_buffers: ShBuffers,
@@ -236,6 +300,10 @@ impl Frame {
             irradiance: IrradiancePass::new(ctx)?,
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx)?,
+            shadow: ShadowPass::new(ctx)?,
+            shadow_views: shadow_views(scene).into_iter().flatten().collect(),
+            shadow_resolution: scene.file.render.shadow_resolution,
+            prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
             sh: ShPasses::new(ctx, samplers.nearest.clone())?,
             sh_buffers: ShBuffers::new(
@@ -262,11 +330,13 @@ impl Frame {
 
     /// Builds the frame graph; returns the image to read back (and its size)
     /// for `view`, and for screen views the tone-mapped 8-bit image.
+    /// `first`: the render's first frame (it also prefilters the environment).
     fn graph(
         &self,
         g: &mut Graph,
         view: View,
         (w, h): (u32, u32),
+        first: bool,
     ) -> (ImageHandle, Option<ImageHandle>) {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let sh = self.sh.passes(
@@ -275,20 +345,29 @@ impl Frame {
             &self.sh_buffers,
             Access::FragmentBufferRead,
         );
+        if view == View::Prefiltered {
+            return (self.prefilter.pass(g, &self.inputs.env, first), None);
+        }
+        let shadows = self.shadow.pass(
+            g,
+            &self.inputs.mesh,
+            &self.shadow_views,
+            self.shadow_resolution,
+        );
         if let View::Direct | View::Occlusion = view {
             let (pipeline, name) = match view {
                 View::Direct => (&self.forward.direct, "direct"),
                 _ => (&self.forward.occlusion, "occlusion"),
             };
             forward::background(g, &self.forward, &self.inputs, &mut hdr);
-            forward::direct(g, pipeline, name, &self.inputs, &sh, &mut hdr);
+            forward::direct(g, pipeline, name, &self.inputs, &sh, &shadows, &mut hdr);
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
             let stretch = self.stretch.pass(g, mesh, res, self.constant_stretch);
-            let irradiance = self
-                .irradiance
-                .pass(g, &self.inputs, &sh, res, self.skin.mix);
+            let irradiance =
+                self.irradiance
+                    .pass(g, &self.inputs, &sh, &shadows, res, self.skin.mix);
             if view == View::Stretch {
                 return (stretch, None);
             }
@@ -302,6 +381,7 @@ impl Frame {
                 let mut irr = levels.irradiance;
                 return (irr.swap_remove(k as usize - 1), None);
             }
+            let specular_env = self.prefilter.pass(g, &self.inputs.env, first);
             forward::background(g, &self.forward, &self.inputs, &mut hdr);
             let weights: Vec<_> = self
                 .skin
@@ -321,8 +401,17 @@ impl Frame {
                 mix: self.skin.mix,
                 mode,
             };
-            self.shade
-                .pass(g, &self.inputs, &levels.irradiance, settings, &mut hdr);
+            self.shade.pass(
+                g,
+                &self.inputs,
+                ShadeImages {
+                    levels: &levels.irradiance,
+                    shadows: &shadows,
+                    specular_env: &specular_env,
+                },
+                settings,
+                &mut hdr,
+            );
         }
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
         self.tonemap
@@ -340,6 +429,9 @@ pub fn render_scene(
     check_target(&ctx.info, screen.0, screen.1)?;
     let res = scene.file.render.irradiance_resolution;
     check_target(&ctx.info, res, res)?;
+    let shadow_res = scene.file.render.shadow_resolution;
+    let tiles = shadow_views(scene).iter().flatten().count() as u32;
+    check_target(&ctx.info, shadow_res * tiles.max(1), shadow_res)?;
     if scene.file.skin.profile.len() != 6 {
         return Err(Error::Input(format!(
             "skin.profile has {} Gaussians; the blur chain and final shading use six",
@@ -347,11 +439,7 @@ pub fn render_scene(
         )));
     }
     let frame = Frame::new(ctx, scene)?;
-    let (w, h) = if opts.view.uv_space() {
-        (res, res)
-    } else {
-        screen
-    };
+    let (w, h) = opts.view.size(screen, res);
     let readback = |name: &str, bytes_per_texel: u64| -> Result<Arc<Buffer>> {
         Ok(Arc::new(Buffer::new(
             ctx,
@@ -376,9 +464,9 @@ pub fn render_scene(
     let mut executor = Executor::new(ctx, 2)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
-    for _ in 0..opts.frames.max(1) {
+    for i in 0..opts.frames.max(1) {
         let mut g = Graph::new();
-        let (hdr, ldr) = frame.graph(&mut g, opts.view, screen);
+        let (hdr, ldr) = frame.graph(&mut g, opts.view, screen, i == 0);
         if let (Some(ldr), Some(buf)) = (&ldr, &ldr_readback) {
             readback_pass(&mut g, ldr, buf);
         }

@@ -89,27 +89,40 @@ pub fn upload_rgba8(ctx: &Arc<Context>, name: &str, t: &Texture) -> Result<Arc<I
 }
 
 /// The environment as RGBA32F: the sky's sun disk (~1e6 kcd/m²) does not fit
-/// in half floats (max 65504).
+/// in half floats (max 65504). With a full mip chain where the device filters
+/// RGBA32F (the specular prefilter reads coarse levels), else one level.
 pub fn upload_env(ctx: &Arc<Context>, env: &EnvMap) -> Result<Arc<Image>> {
     let texels: Vec<f32> = env
         .texels
         .iter()
         .flat_map(|c| [c.x, c.y, c.z, 1.0])
         .collect();
-    let desc = ImageDesc::new(env.width, env.height, vk::Format::R32G32B32A32_SFLOAT);
+    let format = vk::Format::R32G32B32A32_SFLOAT;
+    let desc = ImageDesc {
+        mip_levels: if ctx.supports_linear_filter(format) {
+            full_mip_count(env.width, env.height)
+        } else {
+            1
+        },
+        ..ImageDesc::new(env.width, env.height, format)
+    };
     upload_texture(ctx, "environment", desc, bytemuck::cast_slice(&texels))
 }
 
 pub struct Samplers {
     pub linear: Arc<Sampler>,
     pub nearest: Arc<Sampler>,
+    /// Depth comparison for the shadow atlas, bilinear where the device filters D32.
+    pub shadow: Arc<Sampler>,
 }
 
 impl Samplers {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let linear_depth = ctx.supports_linear_filter(crate::light::shadow::SHADOW_FORMAT);
         Ok(Self {
             linear: Arc::new(Sampler::clamped(ctx, true)?),
             nearest: Arc::new(Sampler::clamped(ctx, false)?),
+            shadow: Arc::new(Sampler::shadow(ctx, linear_depth)?),
         })
     }
 }

@@ -402,6 +402,8 @@ pub struct Render {
     pub height: u32,
     /// Side of the UV-space irradiance and blur targets (power of two, 256..=8192).
     pub irradiance_resolution: u32,
+    /// Side of each light's shadow map (power of two, 256..=8192).
+    pub shadow_resolution: u32,
     /// Exposure in EV (stops): output = radiance × 2^exposure. `None`: metered
     /// from the environment (see `Scene::exposure`).
     pub exposure: Option<f32>,
@@ -414,6 +416,7 @@ impl Default for Render {
             width: 1280,
             height: 720,
             irradiance_resolution: 4096,
+            shadow_resolution: 2048,
             exposure: None,
             gamma: Gamma::Srgb,
         }
@@ -723,11 +726,13 @@ impl Render {
                 return Err(format!("{key} = {v}: must be in 1..={MAX_RENDER_SIZE}"));
             }
         }
-        let r = self.irradiance_resolution;
-        if !r.is_power_of_two() || !(256..=8192).contains(&r) {
-            return Err(format!(
-                "render.irradiance_resolution = {r}: must be a power of two in 256..=8192"
-            ));
+        for (key, r) in [
+            ("render.irradiance_resolution", self.irradiance_resolution),
+            ("render.shadow_resolution", self.shadow_resolution),
+        ] {
+            if !r.is_power_of_two() || !(256..=8192).contains(&r) {
+                return Err(format!("{key} = {r}: must be a power of two in 256..=8192"));
+            }
         }
         if let Some(e) = self.exposure {
             finite("render.exposure", e)?;
@@ -996,6 +1001,10 @@ gamma = 2.2
             (
                 "[render]\nirradiance_resolution = 16384",
                 "render.irradiance_resolution",
+            ),
+            (
+                "[render]\nshadow_resolution = 1000",
+                "render.shadow_resolution = 1000",
             ),
             ("[render]\nwidth = 0", "render.width = 0"),
             ("[render]\nheight = 16385", "render.height = 16385"),

@@ -60,12 +60,43 @@ impl Overrides {
     }
 }
 
-/// A light as the shaders use it: direction towards the light and the irradiance
-/// it delivers to a surface facing it.
+/// Where a light is.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionalLight {
-    pub direction: Vec3,
+pub enum LightSource {
+    /// Infinitely far away: the unit direction towards the light.
+    Directional(Vec3),
+    /// A position in the scene, mm.
+    Point(Vec3),
+}
+
+/// An explicit light as the shaders use it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    pub source: LightSource,
+    /// Irradiance on a surface facing the light; for a point light at
+    /// [`POINT_LIGHT_REFERENCE_MM`], falling off as 1/d².
     pub irradiance: Vec3,
+    /// Whether it casts shadows (a shadow map, light::shadow).
+    pub shadow: bool,
+}
+
+/// The distance at which a point light's `intensity` is its irradiance (scene-format.md).
+pub const POINT_LIGHT_REFERENCE_MM: f32 = 1000.0;
+
+impl Light {
+    /// Unit direction towards the light from `x` and the irradiance it delivers
+    /// there to a surface facing it (unshadowed).
+    pub fn at(&self, x: Vec3) -> (Vec3, Vec3) {
+        match self.source {
+            LightSource::Directional(d) => (d, self.irradiance),
+            LightSource::Point(p) => {
+                let d = p - x;
+                let falloff = POINT_LIGHT_REFERENCE_MM * POINT_LIGHT_REFERENCE_MM
+                    / d.length_squared().max(1e-6);
+                (d.normalize_or_zero(), self.irradiance * falloff)
+            }
+        }
+    }
 }
 
 /// A scene loaded into memory, in millimetres.
@@ -79,7 +110,7 @@ pub struct Scene {
     pub regions: Texture,
     pub env: EnvMap,
     pub camera: Camera,
-    pub lights: Vec<DirectionalLight>,
+    pub lights: Vec<Light>,
     /// The settings it was loaded from (skin, render, environment rotation and intensity).
     pub file: SceneFile,
 }
@@ -144,31 +175,20 @@ impl Scene {
             .bounds()
             .ok_or_else(|| crate::Error::Input("the mesh is empty".into()))?;
         let camera = camera_for(&file, bounds);
-        let centre = 0.5 * (bounds.0 + bounds.1);
         let lights = file
             .lights
             .iter()
-            .map(|l| {
-                let colour = Vec3::from(l.color) * l.intensity;
-                match l.kind {
-                    LightKind::Directional => DirectionalLight {
-                        direction: -Vec3::from(l.direction.unwrap_or([0.0, -1.0, 0.0]))
-                            .normalize_or_zero(),
-                        irradiance: colour,
-                    },
-                    // Until shadowed point lights land (the specular issue), a point
-                    // light acts as a directional one seen from the mesh centre.
+            .map(|l| Light {
+                source: match l.kind {
+                    LightKind::Directional => LightSource::Directional(
+                        -Vec3::from(l.direction.unwrap_or([0.0, -1.0, 0.0])).normalize_or_zero(),
+                    ),
                     LightKind::Point => {
-                        let p = Vec3::from(l.position.unwrap_or([0.0, 0.0, 1000.0]));
-                        log::warn!(
-                            "point light at {p}: approximated as directional from the mesh centre"
-                        );
-                        DirectionalLight {
-                            direction: (p - centre).normalize_or_zero(),
-                            irradiance: colour,
-                        }
+                        LightSource::Point(Vec3::from(l.position.unwrap_or([0.0, 0.0, 1000.0])))
                     }
-                }
+                },
+                irradiance: Vec3::from(l.color) * l.intensity,
+                shadow: l.shadow,
             })
             .collect();
         Ok(Scene {

@@ -1,5 +1,5 @@
 //! Irradiance in texture space (GPU Gems 3 §14.5): the mesh rasterised by its
-//! UVs, lit by the SH environment and explicit lights, times albedo^mix.
+//! UVs, lit by the SH environment and the shadowed explicit lights, times albedo^mix.
 
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
@@ -28,6 +28,7 @@ impl IrradiancePass {
                         Binding::StorageBuffer,
                     ][..],
                     &SPECULAR_BINDINGS,
+                    &[Binding::SampledImage],
                 ]
                 .concat(),
                 8,
@@ -35,12 +36,14 @@ impl IrradiancePass {
         })
     }
 
-    /// `sh`: the environment's coefficients (light::sh_pass).
+    /// `sh`: the environment's coefficients (light::sh_pass); `shadows`: the
+    /// lights' shadow atlas (light::shadow).
     pub fn pass(
         &self,
         g: &mut Graph,
         inputs: &Arc<ForwardInputs>,
         sh: &BufferHandle,
+        shadows: &ImageHandle,
         resolution: u32,
         mix: f32,
     ) -> ImageHandle {
@@ -50,6 +53,7 @@ impl IrradiancePass {
         );
         let mut p = g.add_pass("irradiance");
         let coeffs = p.read_buffer(sh, Access::FragmentBufferRead);
+        let atlas = p.read(shadows, Access::FragmentSampled);
         p.color_attachment(&mut out, LoadOp::Clear([0.0; 4]));
         let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
         p.record(move |cx| {
@@ -62,6 +66,7 @@ impl IrradiancePass {
                 Descriptor::StaticStorage(&inp.transfer),
             ];
             d.extend(inp.specular_descriptors());
+            d.push(Descriptor::Sampled(atlas, &inp.samplers.shadow));
             cx.push_descriptors(&pipe, &d);
             cx.push_constants(&pipe, &[mix.to_bits(), u32::from(inp.roughness_map)]);
             inp.mesh.draw(cx);

@@ -1,5 +1,6 @@
 //! Final skin shading in screen space (GPU Gems 3 §14.5; the paper's Fig. 2):
-//! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π.
+//! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π, plus the
+//! KS specular of the lights and the environment.
 
 use crate::error::Result;
 use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
@@ -28,6 +29,16 @@ pub struct ShadeSettings {
     pub mode: ShadeMode,
 }
 
+/// The frame's images the final pass reads.
+pub struct ShadeImages<'a> {
+    /// The six blur levels.
+    pub levels: &'a [ImageHandle],
+    /// The lights' shadow atlas (light::shadow).
+    pub shadows: &'a ImageHandle,
+    /// The KS-prefiltered environment (light::prefilter).
+    pub specular_env: &'a ImageHandle,
+}
+
 /// What the final pass writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadeMode {
@@ -43,13 +54,22 @@ pub struct ShadePass {
 
 impl ShadePass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
-        let mut bindings = vec![Binding::UniformBuffer, Binding::SampledImage];
-        bindings.extend([Binding::SampledImage; 7]);
+        // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
+        // specular environment, six blur levels, the specular bindings.
+        let mut bindings = vec![
+            Binding::UniformBuffer,
+            Binding::SampledImage,
+            Binding::SampledImage,
+            Binding::SampledImage,
+            Binding::StorageBuffer,
+            Binding::SampledImage,
+        ];
+        bindings.extend([Binding::SampledImage; 6]);
         bindings.extend(SPECULAR_BINDINGS);
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
-                vertex: "mesh.vert",
+                vertex: "mesh_lit.vert",
                 fragment: "skin.frag",
                 bindings: &bindings,
                 push_constant_bytes: std::mem::size_of::<ShadePush>() as u32,
@@ -62,22 +82,25 @@ impl ShadePass {
         Ok(Self { pipeline })
     }
 
-    /// Draws the mesh over `hdr` (which holds the background) with the six levels.
+    /// Draws the mesh over `hdr` (which holds the background).
     pub fn pass(
         &self,
         g: &mut Graph,
         inputs: &Arc<ForwardInputs>,
-        levels: &[ImageHandle],
+        images: ShadeImages,
         settings: ShadeSettings,
         hdr: &mut ImageHandle,
     ) {
         let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
         let mut p = g.add_pass("skin");
-        let refs: Vec<_> = levels
+        let refs: Vec<_> = images
+            .levels
             .iter()
             .map(|l| p.read(l, Access::FragmentSampled))
             .collect();
+        let atlas = p.read(images.shadows, Access::FragmentSampled);
+        let env = p.read(images.specular_env, Access::FragmentSampled);
         p.color_attachment(hdr, LoadOp::Load);
         p.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
         let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
@@ -93,9 +116,12 @@ impl ShadePass {
             let mut d = vec![
                 Descriptor::StaticUniform(&inp.uniforms),
                 Descriptor::StaticSampled(&inp.albedo, sampler),
+                Descriptor::StaticSampled(&inp.normal, sampler),
+                Descriptor::Sampled(atlas, &inp.samplers.shadow),
+                Descriptor::StaticStorage(&inp.transfer),
+                Descriptor::Sampled(env, sampler),
             ];
             d.extend(refs.iter().map(|&r| Descriptor::Sampled(r, sampler)));
-            d.push(Descriptor::StaticSampled(&inp.normal, sampler));
             d.extend(inp.specular_descriptors());
             cx.push_descriptors(&pipe, &d);
             cx.push_constants(&pipe, &push);

@@ -1,0 +1,156 @@
+//! Environment specular by split sum (Karis 2013), with the Kelemen/Szirmay-Kalos
+//! lobe: the specular of an environment is approximated as ρs·A(N·V, m) × the
+//! environment averaged over the KS lobe around the reflected direction, where A
+//! is the KS directional albedo table (skin::specular::specular_albedo_lut) and
+//! the average is this module's prefiltered environment (shaders-glsl/
+//! env_prefilter.comp). Both factors are exact for a constant environment; the
+//! split is exact at normal incidence for any environment.
+//!
+//! The environment is fixed for a render, so the pass runs in its first frame
+//! only, into an image that outlives the frames; later frames read it.
+
+use crate::error::Result;
+use crate::gpu::{Binding, Context, Image, ImageDesc, Pipeline, Sampler};
+use crate::graph::{Access, Descriptor, Graph, ImageHandle, Imported};
+use crate::light::envmap::EnvMap;
+use crate::skin::specular::ks_brdf;
+use ash::vk;
+use glam::Vec3;
+use std::sync::Arc;
+
+/// Size of one roughness level, and the levels' roughness m = M0 + k·DM
+/// (shaders-glsl/common/env_specular.glsl). 128×64 resolves the narrowest lobe
+/// (m = 0.1, about 11° across in the reflected direction) with 2.8° texels; the
+/// range spans the skin roughness Weyrich et al. 2006 report (0.2–0.5) with margin.
+pub const WIDTH: u32 = 128;
+pub const HEIGHT: u32 = 64;
+pub const LEVELS: u32 = 8;
+pub const M0: f32 = 0.1;
+pub const DM: f32 = 0.1;
+pub const FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+pub struct PrefilterPass {
+    pipeline: Arc<Pipeline>,
+    sampler: Arc<Sampler>,
+    image: Arc<Image>,
+}
+
+impl PrefilterPass {
+    /// `sampler`: trilinear where the device filters the environment's format.
+    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+        Ok(Self {
+            pipeline: Pipeline::compute(
+                ctx,
+                "env_prefilter.comp",
+                &[Binding::SampledImage, Binding::StorageImage],
+                0,
+            )?,
+            sampler,
+            image: Arc::new(Image::new(
+                ctx,
+                "specular environment",
+                ImageDesc::new(WIDTH, HEIGHT * LEVELS, FORMAT),
+                vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+            )?),
+        })
+    }
+
+    /// The prefiltered environment of `env` (with its mip chain), `WIDTH` ×
+    /// `HEIGHT·LEVELS`, level k in rows [k·HEIGHT, (k+1)·HEIGHT). `first`: the
+    /// render's first frame, which adds the `env_prefilter` pass that fills it;
+    /// later frames import it as it was left.
+    pub fn pass(&self, g: &mut Graph, env: &Arc<Image>, first: bool) -> ImageHandle {
+        let mut out = g.import_image(
+            "specular environment",
+            Imported::Image(self.image.clone()),
+            (!first).then_some(Access::ShaderSampled),
+            Some(Access::ShaderSampled),
+        );
+        if first {
+            let mut p = g.add_pass("env_prefilter");
+            let o = p.write(&mut out, Access::ComputeStorageWrite);
+            let (pipe, env, sampler) = (self.pipeline.clone(), env.clone(), self.sampler.clone());
+            p.record(move |cx| {
+                cx.bind(&pipe);
+                cx.push_descriptors(
+                    &pipe,
+                    &[
+                        Descriptor::StaticSampled(&env, &sampler),
+                        Descriptor::StorageImage(o),
+                    ],
+                );
+                cx.dispatch_2d(WIDTH, HEIGHT * LEVELS, (8, 8));
+            });
+        }
+        out
+    }
+}
+
+/// The direction of texel (x, y) of one level (y within the level), as the shader
+/// computes it.
+pub fn texel_direction(x: u32, y: u32) -> Vec3 {
+    crate::light::envmap::direction(
+        (x as f32 + 0.5) / WIDTH as f32,
+        (y as f32 + 0.5) / HEIGHT as f32,
+    )
+}
+
+/// Roughness of level `k`.
+pub fn level_m(k: u32) -> f32 {
+    M0 + k as f32 * DM
+}
+
+/// CPU reference of one prefiltered value: Σ L(l)·w(l)·dω / Σ w(l)·dω over every
+/// texel of `env`, with w = the KS lobe ks_brdf(r, l, r, m, 1) (N·L included) —
+/// brute force, no sampling.
+pub fn reference(env: &EnvMap, r: Vec3, m: f32) -> Vec3 {
+    let (mut acc, mut total) = (Vec3::ZERO, 0.0f64);
+    for y in 0..env.height {
+        let d_omega = crate::light::envmap::texel_solid_angle(y, env.width, env.height);
+        for x in 0..env.width {
+            let l = env.texel_direction(x, y);
+            let w = ks_brdf(r, l, r, m, 1.0) * d_omega;
+            if w > 0.0 {
+                acc += env.texel(x, y) * w;
+                total += f64::from(w);
+            }
+        }
+    }
+    acc / total.max(1e-30) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_constant_environment_prefilters_to_itself() {
+        let env = EnvMap::uniform(Vec3::new(0.2, 0.5, 1.5), 256, 128);
+        let v = reference(&env, Vec3::new(0.3, 0.4, -0.2).normalize(), 0.3);
+        assert!(
+            (v - Vec3::new(0.2, 0.5, 1.5)).abs().max_element() < 1e-4,
+            "{v}"
+        );
+    }
+
+    #[test]
+    fn the_reference_narrows_with_roughness() {
+        // A bright cap of 10° radius around +Z: a smooth lobe centred on it sees
+        // more of it than a rough one, and a lobe pointing away sees almost none.
+        let env = EnvMap::from_fn(512, 256, |d| {
+            Vec3::splat(if d.z > 10f32.to_radians().cos() {
+                1.0
+            } else {
+                0.0
+            })
+        });
+        let smooth = reference(&env, Vec3::Z, 0.1).x;
+        let rough = reference(&env, Vec3::Z, 0.5).x;
+        let away = reference(&env, -Vec3::Z, 0.3).x;
+        assert!(smooth > 0.5 && smooth < 1.0, "{smooth}");
+        assert!(rough < 0.5 * smooth, "{rough} vs {smooth}");
+        assert!(away < 1e-3, "{away}");
+    }
+}

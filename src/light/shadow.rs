@@ -1,0 +1,183 @@
+//! Shadow maps for the explicit lights (GPU Gems 3 §14.4.1 shadows the irradiance
+//! pass with them): the mesh's depth seen from each shadowed light, one square tile
+//! per light side by side in one D32 atlas, read with 3×3 bilinear PCF by
+//! shaders-glsl/common/lights.glsl.
+
+use crate::error::Result;
+use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::render::resources::{MeshBuffers, Vertex, VERTEX_ATTRIBUTES};
+use crate::scene::LightSource;
+use ash::vk;
+use glam::camera::rh::{proj::vulkan as proj, view::look_at_mat4};
+use glam::{Mat4, Vec3, Vec4};
+use std::sync::Arc;
+
+pub const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// Each light's frustum holds the mesh's bounding sphere grown by this factor, so
+/// PCF taps at the rim stay inside the light's tile.
+const FIT_MARGIN: f32 = 1.05;
+
+/// One light's shadow projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowView {
+    /// World (mm) to the light's clip space (Vulkan: depth in [0, 1]).
+    pub view_proj: Mat4,
+    /// World size of one texel, mm: constant for a directional light; for a point
+    /// light, per mm of distance from it. The shaders' acne offsets scale with it.
+    pub texel_mm: f32,
+}
+
+impl ShadowView {
+    /// The frustum of `light` that holds the sphere (`centre`, `radius`) in a
+    /// `resolution`² map: orthographic for a directional light, a perspective
+    /// cone for a point light. `None` for a point light inside the sphere, which
+    /// no single map can hold (that needs a cube map).
+    pub fn fit(light: LightSource, centre: Vec3, radius: f32, resolution: u32) -> Option<Self> {
+        let r = radius.max(1e-3) * FIT_MARGIN;
+        let res = resolution as f32;
+        let up = |dir: Vec3| {
+            if dir.y.abs() > 0.9 {
+                Vec3::Z
+            } else {
+                Vec3::Y
+            }
+        };
+        match light {
+            LightSource::Directional(towards) => {
+                let eye = centre + towards * 2.0 * r;
+                let view = look_at_mat4(eye, centre, up(towards));
+                let proj = proj::orthographic(-r, r, -r, r, r, 3.0 * r);
+                Some(Self {
+                    view_proj: proj * view,
+                    texel_mm: 2.0 * r / res,
+                })
+            }
+            LightSource::Point(p) => {
+                let d = p.distance(centre);
+                if d <= r {
+                    return None;
+                }
+                let half = (r / d).asin();
+                let view = look_at_mat4(p, centre, up((p - centre) / d));
+                let proj = proj::perspective(2.0 * half, 1.0, d - r, d + r);
+                Some(Self {
+                    view_proj: proj * view,
+                    texel_mm: 2.0 * half.tan() / res,
+                })
+            }
+        }
+    }
+
+    /// World to (atlas u, v, depth) after the divide by w, for tile `tile` of
+    /// `tiles` laid out left to right.
+    pub fn atlas_matrix(&self, tile: usize, tiles: usize) -> Mat4 {
+        let n = tiles as f32;
+        let bias = Mat4::from_cols(
+            Vec4::new(0.5 / n, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, 0.5, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, 1.0, 0.0),
+            Vec4::new((0.5 + tile as f32) / n, 0.5, 0.0, 1.0),
+        );
+        bias * self.view_proj
+    }
+}
+
+/// Renders the atlas: depth only, no culling (scanned meshes are not closed).
+pub struct ShadowPass {
+    pipeline: Arc<Pipeline>,
+}
+
+impl ShadowPass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "shadow.vert",
+                fragment: "shadow.frag",
+                bindings: &[],
+                push_constant_bytes: 64,
+                color_formats: &[],
+                depth_format: Some(SHADOW_FORMAT),
+                vertex_layout: Some((
+                    std::mem::size_of::<Vertex>() as u32,
+                    &VERTEX_ATTRIBUTES[..1],
+                )),
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// The atlas of `views` (tile `i` = `views[i]`), `resolution` texels a side;
+    /// a cleared 1×1 image when there are none, so the lighting shaders always
+    /// have one to bind.
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        mesh: &Arc<MeshBuffers>,
+        views: &[ShadowView],
+        resolution: u32,
+    ) -> ImageHandle {
+        let (w, h) = match views.len() as u32 {
+            0 => (1, 1),
+            n => (n * resolution, resolution),
+        };
+        let mut atlas = g.create_image("shadow atlas", ImageDesc::new(w, h, SHADOW_FORMAT));
+        let mut p = g.add_pass("shadow maps");
+        p.depth_attachment(&mut atlas, LoadOp::Clear([1.0; 4]));
+        let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
+        let matrices: Vec<[f32; 16]> = views.iter().map(|v| v.view_proj.to_cols_array()).collect();
+        p.record(move |cx| {
+            cx.bind(&pipe);
+            for (i, m) in matrices.iter().enumerate() {
+                cx.set_viewport(i as u32 * resolution, 0, resolution, resolution);
+                cx.push_constants(&pipe, m);
+                mesh.draw(cx);
+            }
+        });
+        atlas
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn project(m: Mat4, p: Vec3) -> Vec3 {
+        m.project_point3(p)
+    }
+
+    #[test]
+    fn the_bounding_sphere_fits_inside_each_tile() {
+        let (c, r) = (Vec3::new(10.0, 20.0, -5.0), 100.0);
+        let lights = [
+            LightSource::Directional(Vec3::new(0.3, 0.8, 0.5).normalize()),
+            LightSource::Directional(Vec3::Y),
+            LightSource::Point(c + Vec3::new(300.0, 100.0, 400.0)),
+        ];
+        for (tile, light) in lights.into_iter().enumerate() {
+            let v = ShadowView::fit(light, c, r, 1024).unwrap();
+            let m = v.atlas_matrix(tile, 3);
+            // Points on the sphere land in this tile with depth in (0, 1).
+            for dir in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+                let s = project(m, c + dir * r);
+                let u = s.x * 3.0 - tile as f32;
+                assert!(
+                    u > 0.0 && u < 1.0 && s.y > 0.0 && s.y < 1.0,
+                    "{light:?} {dir} {s}"
+                );
+                assert!(s.z > 0.0 && s.z < 1.0, "{light:?} {dir} {s}");
+            }
+            // Depth grows away from the light.
+            let towards = match light {
+                LightSource::Directional(d) => d,
+                LightSource::Point(p) => (p - c).normalize(),
+            };
+            assert!(project(m, c + towards * r).z < project(m, c).z);
+            assert!(project(m, c).z < project(m, c - towards * r).z);
+        }
+        assert!(ShadowView::fit(LightSource::Point(c), c, r, 1024).is_none());
+    }
+}
