@@ -98,7 +98,8 @@ enum Command {
         width: Option<u32>,
         #[arg(long)]
         height: Option<u32>,
-        /// What to write: final, diffuse, direct, irradiance, stretch, blur1..blur6.
+        /// What to write: final, diffuse, specular, direct, occlusion, irradiance,
+        /// stretch, blur1..blur6, prefiltered.
         #[arg(long, default_value = "final")]
         view: String,
         /// Frames to render; with more than one the first is warm-up.
