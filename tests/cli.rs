@@ -249,6 +249,7 @@ fn views_write_intermediates() {
         "specular",
         "direct",
         "occlusion",
+        "prefiltered",
     ] {
         let png = tmp(&format!("{view}.png"));
         let out = dermis(&[
@@ -270,8 +271,12 @@ fn views_write_intermediates() {
             String::from_utf8_lossy(&out.stderr)
         );
         let size = image::image_dimensions(&png).unwrap();
-        let uv = matches!(view, "blur6" | "irradiance");
-        assert_eq!(size, if uv { (256, 256) } else { (64, 48) }, "{view}");
+        let want = match view {
+            "blur6" | "irradiance" => (256, 256),
+            "prefiltered" => (128, 512),
+            _ => (64, 48),
+        };
+        assert_eq!(size, want, "{view}");
     }
     let out = dermis(&[
         "render",

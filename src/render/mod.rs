@@ -181,8 +181,8 @@ fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
 }
 
 /// The frame's uniforms: camera, environment rotation and intensity, lights and
-/// their shadow projections, exposure.
-pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
+/// their shadow projections (`views`, from [`shadow_views`]), exposure.
+fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let env = &scene.file.environment;
     let mut u = FrameUniforms {
@@ -204,10 +204,9 @@ pub fn frame_uniforms(scene: &Scene, aspect: f32) -> FrameUniforms {
         ],
         params: [scene.exposure(), 0.0, 0.0, 0.0],
     };
-    let views = shadow_views(scene);
     let tiles = views.iter().flatten().count();
     let mut tile = 0;
-    for (i, (l, view)) in scene.lights.iter().zip(&views).enumerate() {
+    for (i, (l, view)) in scene.lights.iter().zip(views).enumerate() {
         u.light_vec[i] = match l.source {
             LightSource::Directional(d) => d.extend(0.0),
             LightSource::Point(p) => p.extend(1.0),
@@ -249,7 +248,15 @@ impl Frame {
     fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let samplers = Arc::new(Samplers::new(ctx)?);
-        let uniforms = frame_uniforms(scene, w as f32 / h as f32);
+        let views = shadow_views(scene);
+        let shadow_res = scene.file.render.shadow_resolution;
+        let tiles = views.iter().flatten().count() as u32;
+        check_target(&ctx.info, shadow_res * tiles.max(1), shadow_res).map_err(|e| {
+            Error::Input(format!(
+                "shadow atlas of {tiles} light(s) at render.shadow_resolution = {shadow_res}: {e}"
+            ))
+        })?;
+        let uniforms = frame_uniforms(scene, w as f32 / h as f32, &views);
         let inputs = Arc::new(ForwardInputs {
             uniforms: upload_buffer(
                 ctx,
@@ -301,7 +308,7 @@ impl Frame {
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx)?,
             shadow: ShadowPass::new(ctx)?,
-            shadow_views: shadow_views(scene).into_iter().flatten().collect(),
+            shadow_views: views.into_iter().flatten().collect(),
             shadow_resolution: scene.file.render.shadow_resolution,
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
@@ -429,9 +436,6 @@ pub fn render_scene(
     check_target(&ctx.info, screen.0, screen.1)?;
     let res = scene.file.render.irradiance_resolution;
     check_target(&ctx.info, res, res)?;
-    let shadow_res = scene.file.render.shadow_resolution;
-    let tiles = shadow_views(scene).iter().flatten().count() as u32;
-    check_target(&ctx.info, shadow_res * tiles.max(1), shadow_res)?;
     if scene.file.skin.profile.len() != 6 {
         return Err(Error::Input(format!(
             "skin.profile has {} Gaussians; the blur chain and final shading use six",
