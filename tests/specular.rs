@@ -394,11 +394,8 @@ fn environment_specular_is_exact_under_a_constant_environment() {
 
 /// Relative errors (max over channels) of the GPU prefiltered environment of
 /// the CC0 map `name` against brute force, on a grid of texels of three levels.
-fn prefilter_errors(name: &str) -> Vec<f32> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets/env")
-        .join(name);
-    let (env, _) = envmap::load(&path).unwrap();
+fn prefilter_errors(dir: &std::path::Path, name: &str) -> Vec<f32> {
+    let (env, _) = envmap::load(&dir.join(name)).unwrap();
     let s = scene(
         sphere(Vec3::ZERO, R, 32, 16, (0.0, 1.0)),
         Vec::new(),
@@ -432,11 +429,16 @@ fn prefilter_errors(name: &str) -> Vec<f32> {
 
 #[test]
 fn prefiltered_environment_matches_brute_force_integration() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/env");
+    if !dir.is_dir() {
+        println!("skipped the CC0 maps: {} is absent", dir.display());
+        return;
+    }
     // A low sun: importance sampling with filtered samples holds it to a few %.
-    let e = prefilter_errors("venice_sunset_1k.hdr");
+    let e = prefilter_errors(&dir, "venice_sunset_1k.hdr");
     assert!(e[e.len() / 2] < 0.01 && e[e.len() - 1] < 0.05, "{e:?}");
     // A tiny, very bright sun: 1024 samples still miss or smear it near its
     // direction (docs/lighting.md); the bulk stays close.
-    let e = prefilter_errors("royal_esplanade_1k.hdr");
+    let e = prefilter_errors(&dir, "royal_esplanade_1k.hdr");
     assert!(e[e.len() / 2] < 0.02 && e[e.len() * 9 / 10] < 0.2, "{e:?}");
 }
