@@ -1,6 +1,7 @@
 #version 460
-// `--view occlusion`: the transfer's DC term (visibility-weighted cosine)
-// relative to an unoccluded vertex's, Â0·Y00 = π·0.282095 (1 = open sky).
+// `--view occlusion`: the vertex's visibility (common/visibility.glsl).
+#extension GL_GOOGLE_include_directive : require
+#include "visibility.glsl"
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -11,6 +12,5 @@ layout(location = 6) in vec3 v_t678;
 layout(location = 0) out vec4 color;
 
 void main() {
-    float open = v_t012.x / (3.14159265358979 * 0.282095);
-    color = vec4(vec3(open), 1.0);
+    color = vec4(vec3(open_sky(v_t012.x)), 1.0);
 }

@@ -28,6 +28,7 @@ layout(binding = 11) uniform sampler2D blur6;
 #define SPEC_PARAMS 17
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
+#include "visibility.glsl"
 // mode: 0 final, 1 diffuse only, 2 specular only.
 layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; uint roughness_map; } pc;
 layout(location = 0) in vec3 v_position;
@@ -63,9 +64,9 @@ void main() {
         vec3 e = light_irradiance(i, v_position, v_normal, l);
         spec += e * ks_specular(n, l, v, params);
     }
-    // The environment's share: occluded like the diffuse by the transfer's
-    // visibility (its DC term relative to open sky; 1 without occlusion).
-    float visibility = frame.env.w > 0.5 ? clamp(v_t012.x / (PI * 0.282095), 0.0, 1.0) : 1.0;
+    // The environment's share, occluded like the diffuse by the vertex's
+    // visibility (1 without occlusion).
+    float visibility = frame.env.w > 0.5 ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
     spec += params.x * specular_albedo(n_dot_v, params.y)
           * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);

@@ -20,8 +20,9 @@ use std::sync::Arc;
 
 /// Size of one roughness level, and the levels' roughness m = M0 + k·DM
 /// (shaders-glsl/common/env_specular.glsl). 128×64 resolves the narrowest lobe
-/// (m = 0.1, about 11° across in the reflected direction) with 2.8° texels; the
-/// range spans the skin roughness Weyrich et al. 2006 report (0.2–0.5) with margin.
+/// (m = 0.1: tan α = m puts its 1/e point 5.7° off the half vector, 11° off the
+/// reflected direction) with 2.8° texels. The range holds d'Eon's default
+/// m = 0.3 (GPU Gems 3 §14.3) with wide margins; other roughness is clamped to it.
 pub const WIDTH: u32 = 128;
 pub const HEIGHT: u32 = 64;
 pub const LEVELS: u32 = 8;

@@ -2003,9 +2003,8 @@ mod tests {
         assert!(ala > 1.5 && ala < 8.0, "alar wall {ala} mm");
     }
 
-    #[test]
-    fn albedo_is_skin_with_redder_lips() {
-        let h = head();
+    /// Which texels of the head's atlas a triangle covers.
+    fn uv_coverage(h: &BuiltinHead) -> Vec<bool> {
         let n = h.texture_size as usize;
         let mut covered = vec![false; n * n];
         for t in h.mesh.indices.chunks_exact(3) {
@@ -2013,6 +2012,13 @@ mod tests {
                 covered[y * n + x] = true
             });
         }
+        covered
+    }
+
+    #[test]
+    fn albedo_is_skin_with_redder_lips() {
+        let h = head();
+        let covered = uv_coverage(h);
         let mut sums = [(0.0f64, 0usize); REGION_COUNT];
         for (i, &inside) in covered.iter().enumerate() {
             let a = &h.albedo_srgb[i * 4..i * 4 + 4];
@@ -2042,13 +2048,7 @@ mod tests {
     #[test]
     fn detail_normals_are_unit_and_face_out() {
         let h = head();
-        let n = h.texture_size as usize;
-        let mut covered = vec![false; n * n];
-        for t in h.mesh.indices.chunks_exact(3) {
-            raster_triangle(&uv_texels(&h.mesh, t, n as f32), n, n, 1e-3, |x, y, _| {
-                covered[y * n + x] = true
-            });
-        }
+        let covered = uv_coverage(h);
         let mut bumped = 0;
         for (px, &inside) in h.normal_detail.chunks_exact(4).zip(&covered) {
             let v = Vec3::new(px[0] as f32, px[1] as f32, px[2] as f32) / 127.5 - Vec3::ONE;
