@@ -3,15 +3,15 @@
 //! measured pass by pass.
 
 pub mod error;
+pub mod frame;
 pub mod gpu;
 pub mod graph;
 pub mod light;
+pub mod post;
 pub mod profile;
+pub mod render;
 pub mod scene;
 pub mod skin;
 pub mod testscene;
 
 pub use error::{Error, Result};
-pub mod output;
-pub mod post;
-pub mod render;

@@ -278,7 +278,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 width,
                 height,
             };
-            let hdr = dermis::output::Format::of(&out)? == dermis::output::Format::Exr;
+            let hdr = dermis::render::output::Format::of(&out)? == dermis::render::output::Format::Exr;
             let output = render(&RenderOptions {
                 scene: overrides.apply(file)?,
                 frames,
@@ -289,7 +289,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             if dump_graph {
                 print!("{}", output.plan);
             }
-            dermis::output::write(&out, &output)?;
+            dermis::render::output::write(&out, &output)?;
             if timings {
                 let r = &output.report;
                 println!(

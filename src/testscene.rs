@@ -2,9 +2,9 @@
 //! procedural pattern through two compute blur passes and a graphics pass.
 
 use crate::error::Result;
-use crate::gpu::{Binding, Buffer, Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
-use crate::graph::upload::readback_pass;
-use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
+use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
+use crate::graph::upload::Readback;
+use crate::graph::{Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -47,8 +47,6 @@ impl TestScene {
                 &GraphicsDesc {
                     vertex: "fullscreen.vert",
                     fragment: "composite.frag",
-                    bindings: &[Binding::SampledImage],
-                    push_constant_bytes: std::mem::size_of::<CompositePush>() as u32,
                     color_formats: &[format],
                     depth_format: None,
                     vertex_layout: None,
@@ -57,13 +55,8 @@ impl TestScene {
             )
         };
         Ok(Self {
-            pattern: Pipeline::compute(ctx, "pattern.comp", &[Binding::StorageImage], 8)?,
-            blur: Pipeline::compute(
-                ctx,
-                "test_blur.comp",
-                &[Binding::SampledImage, Binding::StorageImage],
-                std::mem::size_of::<BlurPush>() as u32,
-            )?,
+            pattern: Pipeline::compute(ctx, "pattern.comp")?,
+            blur: Pipeline::compute(ctx, "test_blur.comp")?,
             composite_rgba8: composite(vk::Format::R8G8B8A8_UNORM)?,
             composite_rgba16f: composite(HALF)?,
             sampler: Arc::new(Sampler::clamped(ctx, false)?),
@@ -92,22 +85,11 @@ impl TestScene {
         sigma: f32,
     ) {
         let (w, h) = (dst.desc.width, dst.desc.height);
-        let mut p = g.add_pass(name);
-        let s = p.read(src, Access::ComputeSampled);
-        let d = p.write(dst, Access::ComputeStorageWrite);
-        let (pipe, sampler) = (self.blur.clone(), self.sampler.clone());
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::Sampled(s, &sampler),
-                    Descriptor::StorageImage(d),
-                ],
-            );
-            cx.push_constants(&pipe, &BlurPush { dir, radius, sigma });
-            cx.dispatch_2d(w, h, (8, 8));
-        });
+        g.simple_pass(name, &self.blur)
+            .sample(src, &self.sampler)
+            .store(dst)
+            .constants(&BlurPush { dir, radius, sigma })
+            .dispatch([w, h, 1]);
     }
 
     /// Composites `src` into `target` (a colour attachment) with `push`.
@@ -120,35 +102,25 @@ impl TestScene {
         push: CompositePush,
     ) {
         let pipe = if target.desc.format == HALF {
-            self.composite_rgba16f.clone()
+            &self.composite_rgba16f
         } else {
-            self.composite_rgba8.clone()
+            &self.composite_rgba8
         };
-        let sampler = self.sampler.clone();
-        let mut p = g.add_pass("composite");
-        let s = p.read(src, Access::FragmentSampled);
-        p.color_attachment(target, load);
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(&pipe, &[Descriptor::Sampled(s, &sampler)]);
-            cx.push_constants(&pipe, &push);
-            cx.draw(3, 1);
-        });
+        g.simple_pass("composite", pipe)
+            .sample(src, &self.sampler)
+            .color(target, load)
+            .constants(&push)
+            .draw(3);
     }
 
     /// The demo frame: pattern → blur_h → blur_v → composite (sRGB) → readback
     /// into `readback` (width × height × 4 bytes, RGBA8).
-    pub fn frame(&self, g: &mut Graph, width: u32, height: u32, readback: &Arc<Buffer>) {
+    pub fn frame(&self, g: &mut Graph, width: u32, height: u32, readback: &Readback) {
         let mut pattern = g.create_image("pattern", ImageDesc::new(width, height, HALF));
-        let pipe = self.pattern.clone();
-        let mut p = g.add_pass("pattern");
-        let dst = p.write(&mut pattern, Access::ComputeStorageWrite);
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(&pipe, &[Descriptor::StorageImage(dst)]);
-            cx.push_constants(&pipe, &[width, height]);
-            cx.dispatch_2d(width, height, (8, 8));
-        });
+        g.simple_pass("pattern", &self.pattern)
+            .store(&mut pattern)
+            .constants(&[width, height])
+            .dispatch([width, height, 1]);
         let blurred = self.blur(g, &pattern, 6, 3.0);
         let mut ldr = g.create_image(
             "ldr",
@@ -161,6 +133,6 @@ impl TestScene {
             encode_srgb: 1,
         };
         self.composite(g, &blurred, &mut ldr, LoadOp::DontCare, push);
-        readback_pass(g, &ldr, readback);
+        readback.image_pass(g, &ldr);
     }
 }

@@ -5,7 +5,7 @@ mod common;
 
 use ash::vk;
 use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation};
-use dermis::graph::upload::readback_pass;
+use dermis::graph::upload::Readback;
 use dermis::graph::{Access, Clock, Compiled, Executor, Graph, Imported, LoadOp};
 use dermis::testscene::{CompositePush, TestScene, HALF};
 use std::sync::Arc;
@@ -65,7 +65,7 @@ fn expected(input: &[f32]) -> Vec<f32> {
 struct Chain {
     scene: TestScene,
     staging: Arc<Buffer>,
-    readback: Arc<Buffer>,
+    readback: Readback,
 }
 
 fn chain(ctx: &Arc<Context>, input: &[f32]) -> Chain {
@@ -82,18 +82,11 @@ fn chain(ctx: &Arc<Context>, input: &[f32]) -> Chain {
         .mapped_mut()
         .unwrap()
         .copy_from_slice(&common::to_f16_bytes(input));
-    let readback = Buffer::new(
-        ctx,
-        "readback",
-        bytes,
-        vk::BufferUsageFlags::TRANSFER_DST,
-        MemoryLocation::GpuToCpu,
-    )
-    .unwrap();
+    let readback = Readback::new(ctx, "readback", bytes).unwrap();
     Chain {
         scene: TestScene::new(ctx).unwrap(),
         staging: Arc::new(staging),
-        readback: Arc::new(readback),
+        readback,
     }
 }
 
@@ -122,7 +115,7 @@ fn build(ex: &mut Executor, c: &Chain) -> Compiled {
     };
     c.scene
         .composite(&mut g, &blurred, &mut target, LoadOp::Load, push);
-    readback_pass(&mut g, &target, &c.readback);
+    c.readback.image_pass(&mut g, &target);
     ex.compile(g).unwrap()
 }
 
@@ -149,7 +142,7 @@ fn chain_matches_cpu_reference_over_frames() {
         }
         reports.extend(ex.finish().unwrap());
         assert_eq!(reports.len(), 3, "one report per frame");
-        let got = common::from_f16_bytes(c.readback.mapped().unwrap());
+        let got = common::from_f16_bytes(c.readback.bytes().unwrap());
         let err = max_error(&got, &want);
         println!("max |GPU - CPU| = {err:e}");
         // Values lie in [0.25, 0.75] where an f16 ulp is 2^-11 ≈ 4.9e-4; two rounding

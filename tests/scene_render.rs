@@ -132,7 +132,7 @@ fn exr_is_the_linear_image_behind_the_png() {
     // One 8-bit step of rounding plus f16 storage of the HDR target.
     assert!(worst <= 1.5, "PNG and EXR disagree by {worst} / 255");
     let path = std::env::temp_dir().join(format!("dermis-{}.exr", std::process::id()));
-    dermis::output::write(&path, &out).unwrap();
+    dermis::render::output::write(&path, &out).unwrap();
     let read = exr::prelude::read_first_rgba_layer_from_file(
         &path,
         |res, _| vec![0.0f32; res.width() * res.height() * 4],

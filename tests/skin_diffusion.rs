@@ -4,12 +4,11 @@
 
 mod common;
 
-use ash::vk;
-use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation, Sampler};
-use dermis::graph::upload::readback_pass;
+use dermis::gpu::{Context, ImageDesc, Sampler};
+use dermis::graph::upload::Readback;
 use dermis::graph::upload::upload_texture;
 use dermis::graph::{Access, Executor, Graph, Imported};
-use dermis::render::resources::MeshBuffers;
+use dermis::frame::MeshBuffers;
 use dermis::scene::mesh::Mesh;
 use dermis::skin::blur::{BlurChain, BlurKernel};
 use dermis::skin::profile::{gaussian, Kernel, Profile};
@@ -54,19 +53,8 @@ fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool)
         let stretch = StretchPass::new(ctx).unwrap();
         let blur =
             BlurChain::new(ctx, kernel, Arc::new(Sampler::clamped(ctx, true).unwrap())).unwrap();
-        let readbacks: Vec<Arc<Buffer>> = (0..6)
-            .map(|_| {
-                Arc::new(
-                    Buffer::new(
-                        ctx,
-                        "level",
-                        (N * N * 8) as u64,
-                        vk::BufferUsageFlags::TRANSFER_DST,
-                        MemoryLocation::GpuToCpu,
-                    )
-                    .unwrap(),
-                )
-            })
+        let readbacks: Vec<Readback> = (0..6)
+            .map(|_| Readback::new(ctx, "level", (N * N * 8) as u64).unwrap())
             .collect();
         let mut g = Graph::new();
         let input = g.import_image(
@@ -79,7 +67,7 @@ fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool)
         let st = stretch.pass(&mut g, &buffers, N, constant);
         let levels = blur.chain(&mut g, &input, &st, &Profile::skin());
         for (level, buf) in levels.irradiance.iter().zip(&readbacks) {
-            readback_pass(&mut g, level, buf);
+            buf.image_pass(&mut g, level);
         }
         let mut ex = Executor::new(ctx, 1).unwrap();
         ex.run(g).unwrap();
@@ -87,7 +75,7 @@ fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool)
         readbacks
             .iter()
             .map(|b| {
-                common::from_f16_bytes(b.mapped().unwrap())
+                common::from_f16_bytes(b.bytes().unwrap())
                     .chunks_exact(4)
                     .map(|p| {
                         if p[3] > 1e-4 {

@@ -3,27 +3,16 @@
 
 mod common;
 
-use ash::vk;
-use dermis::gpu::{Buffer, MemoryLocation};
 use dermis::graph::{Clock, Executor, Graph};
 use dermis::profile::FrameReport;
+use dermis::graph::upload::Readback;
 use dermis::testscene::TestScene;
-use std::sync::Arc;
 
 fn frames(clock: Clock) -> Vec<FrameReport> {
     common::with_gpu(|ctx| {
         let (w, h) = (96, 64);
         let scene = TestScene::new(ctx).unwrap();
-        let readback = Arc::new(
-            Buffer::new(
-                ctx,
-                "readback",
-                w as u64 * h as u64 * 4,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )
-            .unwrap(),
-        );
+        let readback = Readback::new(ctx, "readback", w as u64 * h as u64 * 4).unwrap();
         let mut ex = Executor::new(ctx, 2).unwrap();
         ex.set_clock(clock).unwrap();
         let mut reports = Vec::new();

@@ -3,12 +3,14 @@
 
 mod context;
 mod pipeline;
+mod reflect;
 mod resources;
 pub mod shaders;
 mod validation;
 
 pub use context::{Context, ContextOptions, DeviceInfo, MemoryHeap};
-pub use pipeline::{Binding, GraphicsDesc, Pipeline};
+pub use pipeline::{GraphicsDesc, Pipeline};
+pub use reflect::ShaderLayout;
 pub(crate) use resources::full_range;
 pub use resources::{aspect, texel_bytes, Buffer, Image, ImageDesc, Sampler};
 pub use validation::ValidationLog;

@@ -2,37 +2,15 @@
 //! push descriptors (VK_KHR_push_descriptor): one set per pipeline, written at
 //! record time, so there are no descriptor pools to manage.
 
-use super::{shaders, Context};
+use super::{shaders, Context, ShaderLayout};
 use crate::error::{Result, VkResultExt};
 use ash::vk;
 use std::sync::Arc;
-
-/// One binding of a pipeline's descriptor set, in binding order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Binding {
-    StorageImage,
-    SampledImage,
-    UniformBuffer,
-    StorageBuffer,
-}
-
-impl Binding {
-    fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            Binding::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-            Binding::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-            Binding::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
-            Binding::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
-        }
-    }
-}
 
 /// Fixed-function state of a graphics pipeline (dynamic rendering, dynamic viewport).
 pub struct GraphicsDesc<'a> {
     pub vertex: &'a str,
     pub fragment: &'a str,
-    pub bindings: &'a [Binding],
-    pub push_constant_bytes: u32,
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
     /// Vertex buffer stride and (format, offset) per location; `None`: no vertex input.
@@ -48,6 +26,8 @@ pub struct Pipeline {
     set_layout: vk::DescriptorSetLayout,
     pub bind_point: vk::PipelineBindPoint,
     pub stages: vk::ShaderStageFlags,
+    /// Bindings, push-constant size and workgroup size, reflected from the SPIR-V.
+    pub interface: ShaderLayout,
 }
 
 impl Pipeline {
@@ -56,21 +36,24 @@ impl Pipeline {
         name: &str,
         bind_point: vk::PipelineBindPoint,
         stages: vk::ShaderStageFlags,
-        bindings: &[Binding],
-        push_constant_bytes: u32,
+        interface: ShaderLayout,
     ) -> Result<Self> {
         let device = &ctx.device;
-        let vk_bindings: Vec<_> = bindings
+        let vk_bindings: Vec<_> = interface
+            .bindings
             .iter()
             .enumerate()
-            .map(|(i, b)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(b.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(stages)
+            .filter_map(|(i, ty)| {
+                ty.map(|ty| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(i as u32)
+                        .descriptor_type(ty)
+                        .descriptor_count(1)
+                        .stage_flags(stages)
+                })
             })
             .collect();
+        let push_constant_bytes = interface.push_constant_bytes;
         let set_info = vk::DescriptorSetLayoutCreateInfo::default()
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&vk_bindings);
@@ -84,6 +67,7 @@ impl Pipeline {
             set_layout,
             bind_point,
             stages,
+            interface,
         };
         let ranges = [vk::PushConstantRange {
             stage_flags: stages,
@@ -100,19 +84,14 @@ impl Pipeline {
         Ok(p)
     }
 
-    pub fn compute(
-        ctx: &Arc<Context>,
-        shader: &str,
-        bindings: &[Binding],
-        push_constant_bytes: u32,
-    ) -> Result<Arc<Self>> {
+    /// A compute pipeline; its layout is reflected from the shader.
+    pub fn compute(ctx: &Arc<Context>, shader: &str) -> Result<Arc<Self>> {
         let mut p = Self::with_layout(
             ctx,
             shader,
             vk::PipelineBindPoint::COMPUTE,
             vk::ShaderStageFlags::COMPUTE,
-            bindings,
-            push_constant_bytes,
+            ShaderLayout::of(shader)?,
         )?;
         let module = ShaderModule::new(ctx, shader)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
@@ -132,6 +111,7 @@ impl Pipeline {
         Ok(Arc::new(p))
     }
 
+    /// A graphics pipeline; its layout is the union of both stages' reflection.
     pub fn graphics(ctx: &Arc<Context>, desc: &GraphicsDesc) -> Result<Arc<Self>> {
         let name = format!("{}+{}", desc.vertex, desc.fragment);
         let mut p = Self::with_layout(
@@ -139,8 +119,7 @@ impl Pipeline {
             &name,
             vk::PipelineBindPoint::GRAPHICS,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            desc.bindings,
-            desc.push_constant_bytes,
+            ShaderLayout::of(desc.vertex)?.merge(&ShaderLayout::of(desc.fragment)?)?,
         )?;
         let vs = ShaderModule::new(ctx, desc.vertex)?;
         let fs = ShaderModule::new(ctx, desc.fragment)?;

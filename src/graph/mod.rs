@@ -8,11 +8,15 @@
 
 mod access;
 mod execute;
+mod pass_cx;
 mod plan;
+mod simple;
 pub mod upload;
 
 pub use access::{Access, AccessInfo};
-pub use execute::{Clock, Compiled, Descriptor, Executor, PassCx, ResolvedImage};
+pub use execute::{Clock, Compiled, Executor};
+pub use pass_cx::{Descriptor, PassCx, ResolvedImage};
+pub use simple::SimplePass;
 pub use plan::{Barrier, Plan, PlannedPass, PlannedResource, PoolState};
 
 use crate::gpu::{Buffer, Image, ImageDesc};
@@ -100,6 +104,8 @@ pub(crate) struct PassDecl {
 pub struct Graph {
     pub(crate) resources: Vec<ResourceDecl>,
     pub(crate) passes: Vec<PassDecl>,
+    /// Declarations that contradict a shader's reflected layout; compiling fails.
+    pub(crate) errors: Vec<String>,
 }
 
 impl Graph {

@@ -174,6 +174,9 @@ impl PoolState {
 impl Graph {
     /// Derives the plan. `pool` is updated only when compilation succeeds.
     pub fn compile(&self, pool: &mut PoolState) -> Result<Plan> {
+        if !self.errors.is_empty() {
+            return Err(Error::Graph(self.errors.join("; ")));
+        }
         let mut resources = self.plan_resources()?;
         let mut next_pool = pool.clone();
         assign_slots(&mut resources, &mut next_pool);

@@ -3,7 +3,7 @@
 //! its own executor and waits, and leaves the result ready for any shader), and
 //! the readback pass frames end with.
 
-use super::{Access, Executor, Graph, Imported};
+use super::{Access, BufferHandle, Executor, Graph, ImageHandle, Imported};
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, Image, ImageDesc, MemoryLocation};
 use ash::vk;
@@ -57,18 +57,7 @@ pub fn upload_buffer(
     let mut p = g.add_pass("upload");
     let s = p.read_buffer(&src, Access::TransferSrc);
     let d = p.write_buffer(&mut dst, Access::TransferDst);
-    p.record(move |cx| {
-        let region = vk::BufferCopy {
-            src_offset: 0,
-            dst_offset: 0,
-            size,
-        };
-        unsafe {
-            cx.ctx
-                .device
-                .cmd_copy_buffer(cx.cmd, cx.buffer(s), cx.buffer(d), &[region])
-        };
-    });
+    p.record(move |cx| cx.copy_buffer(s, d, size));
     run_once(ctx, g)?;
     Ok(buffer)
 }
@@ -140,16 +129,58 @@ fn run_once(ctx: &Arc<Context>, g: Graph) -> Result<()> {
     Ok(())
 }
 
-/// Copies `image` into a host-visible buffer and leaves it ready for the host.
-pub fn readback_pass(g: &mut Graph, image: &super::ImageHandle, buffer: &Arc<Buffer>) {
-    let mut out = g.import_buffer(
-        "readback",
-        Imported::Buffer(buffer.clone()),
-        Some(Access::HostRead),
-        Some(Access::HostRead),
-    );
-    let mut p = g.add_pass("readback");
-    let src = p.read(image, Access::TransferSrc);
-    let dst = p.write_buffer(&mut out, Access::TransferDst);
-    p.record(move |cx| cx.copy_image_to_buffer(src, dst));
+/// A host-visible buffer that frames copy an image or a buffer into; read it
+/// after the frame's fence (`Executor::finish`).
+pub struct Readback {
+    buffer: Arc<Buffer>,
+}
+
+impl Readback {
+    pub fn new(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Self> {
+        let buffer = Buffer::new(
+            ctx,
+            name,
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        Ok(Self {
+            buffer: Arc::new(buffer),
+        })
+    }
+
+    fn import(&self, g: &mut Graph) -> BufferHandle {
+        g.import_buffer(
+            "readback",
+            Imported::Buffer(self.buffer.clone()),
+            Some(Access::HostRead),
+            Some(Access::HostRead),
+        )
+    }
+
+    /// A pass that copies level 0 of `image`, tightly packed.
+    pub fn image_pass(&self, g: &mut Graph, image: &ImageHandle) {
+        let mut out = self.import(g);
+        let mut p = g.add_pass("readback");
+        let src = p.read(image, Access::TransferSrc);
+        let dst = p.write_buffer(&mut out, Access::TransferDst);
+        p.record(move |cx| cx.copy_image_to_buffer(src, dst));
+    }
+
+    /// A pass that copies the start of `buffer` (as much as this one holds).
+    pub fn buffer_pass(&self, g: &mut Graph, buffer: &BufferHandle) {
+        let size = self.buffer.size.min(buffer.size);
+        let mut out = self.import(g);
+        let mut p = g.add_pass("readback");
+        let src = p.read_buffer(buffer, Access::TransferSrc);
+        let dst = p.write_buffer(&mut out, Access::TransferDst);
+        p.record(move |cx| cx.copy_buffer(src, dst, size));
+    }
+
+    /// The copied bytes (valid once the frames that copy have finished).
+    pub fn bytes(&self) -> Result<&[u8]> {
+        self.buffer
+            .mapped()
+            .ok_or_else(|| Error::Graph("readback buffer is not host-visible".into()))
+    }
 }

@@ -1,6 +1,7 @@
 //! Environment lighting: environment maps and the built-in sky, spherical
 //! harmonics (Ramamoorthi & Hanrahan 2001; the paper's section III).
 
+pub mod direct;
 pub mod envmap;
 pub mod occlusion;
 pub mod occlusion_raster;
@@ -8,6 +9,7 @@ pub mod prefilter;
 pub mod sh;
 pub mod sh_pass;
 pub mod shadow;
+pub mod skybox;
 pub mod sky;
 
 use crate::error::Result;

@@ -7,12 +7,10 @@
 
 use super::occlusion::Transfer;
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Binding, Buffer, Context, GraphicsDesc, ImageDesc, MemoryLocation, Pipeline, Sampler,
-};
+use crate::frame::{MeshBuffers, Vertex};
+use crate::gpu::{Buffer, Context, GraphicsDesc, ImageDesc, MemoryLocation, Pipeline, Sampler};
 use crate::graph::upload::upload_buffer;
-use crate::graph::{Access, Descriptor, Executor, Graph, Imported, LoadOp};
-use crate::render::resources::{MeshBuffers, Vertex};
+use crate::graph::{Access, Executor, Graph, Imported, LoadOp};
 use crate::scene::mesh::Mesh;
 use ash::vk;
 use std::sync::Arc;
@@ -123,27 +121,14 @@ pub fn raster_vertices(
         &GraphicsDesc {
             vertex: "occlusion_cube.vert",
             fragment: "occlusion_cube.frag",
-            bindings: &[],
-            push_constant_bytes: std::mem::size_of::<CubePush>() as u32,
             color_formats: &[vk::Format::R8_UNORM],
             depth_format: None,
-            vertex_layout: Some((
-                std::mem::size_of::<Vertex>() as u32,
-                &[(vk::Format::R32G32B32_SFLOAT, 0)],
-            )),
+            // Positions only.
+            vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
             cull_mode: vk::CullModeFlags::NONE,
         },
     )?;
-    let reduce = Pipeline::compute(
-        ctx,
-        "occlusion_reduce.comp",
-        &[
-            Binding::SampledImage,
-            Binding::StorageBuffer,
-            Binding::StorageBuffer,
-        ],
-        std::mem::size_of::<ReducePush>() as u32,
-    )?;
+    let reduce = Pipeline::compute(ctx, "occlusion_reduce.comp")?;
     let sampler = Arc::new(Sampler::clamped(ctx, false)?);
     let cameras: Arc<Vec<[f32; 3]>> = Arc::new(
         vertices
@@ -163,11 +148,11 @@ pub fn raster_vertices(
             "occlusion atlas",
             ImageDesc::new(opts.atlas, opts.atlas, vk::Format::R8_UNORM),
         );
-        let mut p = g.add_pass("occlusion_raster");
-        p.color_attachment(&mut atlas, LoadOp::Clear([1.0; 4]));
         let (pipe, mesh_buffers, cams) = (cube.clone(), buffers.clone(), cameras.clone());
+        let p = g
+            .simple_pass("occlusion_raster", &cube)
+            .color(&mut atlas, LoadOp::Clear([1.0; 4]));
         p.record(move |cx| {
-            cx.bind(&pipe);
             cx.bind_vertex_buffer(&mesh_buffers.vertices);
             cx.bind_index_buffer(&mesh_buffers.indices);
             for v in 0..count {
@@ -196,29 +181,18 @@ pub fn raster_vertices(
             Some(Access::HostRead),
             Some(Access::HostRead),
         );
-        let mut p = g.add_pass("occlusion_reduce");
-        let a = p.read(&atlas, Access::ComputeSampled);
-        let t = p.write_buffer(&mut out, Access::ComputeBufferWrite);
-        let (pipe, normals, sampler) = (reduce.clone(), normals.clone(), sampler.clone());
-        let push = ReducePush {
-            first_vertex: first as u32,
-            count: count as u32,
-            face_size: face,
-            tiles_per_row,
-        };
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::Sampled(a, &sampler),
-                    Descriptor::StaticStorage(&normals),
-                    Descriptor::Storage(t),
-                ],
-            );
-            cx.push_constants(&pipe, &push);
-            unsafe { cx.ctx.device.cmd_dispatch(cx.cmd, count as u32, 1, 1) };
-        });
+        // One workgroup per vertex.
+        g.simple_pass("occlusion_reduce", &reduce)
+            .sample(&atlas, &sampler)
+            .buffer(&normals)
+            .write_buffer(&mut out)
+            .constants(&ReducePush {
+                first_vertex: first as u32,
+                count: count as u32,
+                face_size: face,
+                tiles_per_row,
+            })
+            .dispatch_groups([count as u32, 1, 1]);
         ex.run(g)?;
         if let Some(b) = &bar {
             b.inc(count as u64);

@@ -10,8 +10,8 @@
 //! only, into an image that outlives the frames; later frames read it.
 
 use crate::error::Result;
-use crate::gpu::{Binding, Context, Image, ImageDesc, Pipeline, Sampler};
-use crate::graph::{Access, Descriptor, Graph, ImageHandle, Imported};
+use crate::gpu::{Context, Image, ImageDesc, Pipeline, Sampler};
+use crate::graph::{Access, Graph, ImageHandle, Imported};
 use crate::light::envmap::EnvMap;
 use crate::skin::specular::ks_brdf;
 use ash::vk;
@@ -40,12 +40,7 @@ impl PrefilterPass {
     /// `sampler`: trilinear where the device filters the environment's format.
     pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
         Ok(Self {
-            pipeline: Pipeline::compute(
-                ctx,
-                "env_prefilter.comp",
-                &[Binding::SampledImage, Binding::StorageImage],
-                0,
-            )?,
+            pipeline: Pipeline::compute(ctx, "env_prefilter.comp")?,
             sampler,
             image: Arc::new(Image::new(
                 ctx,
@@ -70,20 +65,10 @@ impl PrefilterPass {
             Some(Access::ShaderSampled),
         );
         if first {
-            let mut p = g.add_pass("env_prefilter");
-            let o = p.write(&mut out, Access::ComputeStorageWrite);
-            let (pipe, env, sampler) = (self.pipeline.clone(), env.clone(), self.sampler.clone());
-            p.record(move |cx| {
-                cx.bind(&pipe);
-                cx.push_descriptors(
-                    &pipe,
-                    &[
-                        Descriptor::StaticSampled(&env, &sampler),
-                        Descriptor::StorageImage(o),
-                    ],
-                );
-                cx.dispatch_2d(WIDTH, HEIGHT * LEVELS, (8, 8));
-            });
+            g.simple_pass("env_prefilter", &self.pipeline)
+                .texture(env, &self.sampler)
+                .store(&mut out)
+                .dispatch([WIDTH, HEIGHT * LEVELS, 1]);
         }
         out
     }

@@ -5,10 +5,11 @@
 
 use super::envmap::EnvMap;
 use super::sh::{self, Sh9};
-use crate::error::{Error, Result};
-use crate::gpu::{Binding, Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
-use crate::graph::upload::upload_buffer;
-use crate::graph::{Access, BufferHandle, Descriptor, Executor, Graph, Imported};
+use crate::error::Result;
+use crate::frame::upload_env;
+use crate::gpu::{Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
+use crate::graph::upload::{upload_buffer, Readback};
+use crate::graph::{Access, BufferHandle, Executor, Graph, Imported};
 use crate::profile::FrameReport;
 use ash::vk;
 use glam::{Mat3, Vec3};
@@ -83,22 +84,8 @@ impl ShBuffers {
 impl ShPasses {
     pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
         Ok(Self {
-            project: Pipeline::compute(
-                ctx,
-                "sh_project.comp",
-                &[Binding::SampledImage, Binding::StorageBuffer],
-                0,
-            )?,
-            reduce: Pipeline::compute(
-                ctx,
-                "sh_reduce.comp",
-                &[
-                    Binding::StorageBuffer,
-                    Binding::StorageBuffer,
-                    Binding::StorageBuffer,
-                ],
-                4,
-            )?,
+            project: Pipeline::compute(ctx, "sh_project.comp")?,
+            reduce: Pipeline::compute(ctx, "sh_reduce.comp")?,
             sampler,
         })
     }
@@ -124,42 +111,17 @@ impl ShPasses {
             Some(readers),
             None,
         );
-        let mut p = g.add_pass("sh_project");
-        let out = p.write_buffer(&mut partials, Access::ComputeBufferWrite);
-        let (pipe, env, sampler, rows) = (
-            self.project.clone(),
-            env.clone(),
-            self.sampler.clone(),
-            b.rows,
-        );
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::StaticSampled(&env, &sampler),
-                    Descriptor::Storage(out),
-                ],
-            );
-            unsafe { cx.ctx.device.cmd_dispatch(cx.cmd, rows, 1, 1) };
-        });
-        let mut p = g.add_pass("sh_reduce");
-        let parts = p.read_buffer(&partials, Access::ComputeBufferRead);
-        let coeffs = p.write_buffer(&mut coefficients, Access::ComputeBufferWrite);
-        let (pipe, transform) = (self.reduce.clone(), b.transform.clone());
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::Storage(parts),
-                    Descriptor::StaticStorage(&transform),
-                    Descriptor::Storage(coeffs),
-                ],
-            );
-            cx.push_constants(&pipe, &rows);
-            unsafe { cx.ctx.device.cmd_dispatch(cx.cmd, 1, 1, 1) };
-        });
+        // One workgroup per row, then one workgroup sums the rows.
+        g.simple_pass("sh_project", &self.project)
+            .texture(env, &self.sampler)
+            .write_buffer(&mut partials)
+            .dispatch_groups([b.rows, 1, 1]);
+        g.simple_pass("sh_reduce", &self.reduce)
+            .read_buffer(&partials)
+            .buffer(&b.transform)
+            .write_buffer(&mut coefficients)
+            .constants(&b.rows)
+            .dispatch_groups([1, 1, 1]);
         coefficients
     }
 }
@@ -172,44 +134,17 @@ pub fn project(
     rotation_deg: f32,
     intensity: f32,
 ) -> Result<(Sh9, FrameReport)> {
-    let image = crate::render::resources::upload_env(ctx, env)?;
+    let image = upload_env(ctx, env)?;
     let passes = ShPasses::new(ctx, Arc::new(Sampler::clamped(ctx, false)?))?;
     let buffers = ShBuffers::new(ctx, &image, rotation_deg, intensity)?;
-    let readback = Arc::new(Buffer::new(
-        ctx,
-        "sh readback",
-        9 * 16,
-        vk::BufferUsageFlags::TRANSFER_DST,
-        MemoryLocation::GpuToCpu,
-    )?);
+    let readback = Readback::new(ctx, "sh readback", 9 * 16)?;
     let mut g = Graph::new();
     let coefficients = passes.passes(&mut g, &image, &buffers, Access::TransferSrc);
-    let mut out = g.import_buffer(
-        "sh readback",
-        Imported::Buffer(readback.clone()),
-        None,
-        Some(Access::HostRead),
-    );
-    let mut p = g.add_pass("readback");
-    let src = p.read_buffer(&coefficients, Access::TransferSrc);
-    let dst = p.write_buffer(&mut out, Access::TransferDst);
-    p.record(move |cx| unsafe {
-        let region = vk::BufferCopy {
-            src_offset: 0,
-            dst_offset: 0,
-            size: 9 * 16,
-        };
-        cx.ctx
-            .device
-            .cmd_copy_buffer(cx.cmd, cx.buffer(src), cx.buffer(dst), &[region]);
-    });
+    readback.buffer_pass(&mut g, &coefficients);
     let mut ex = Executor::new(ctx, 1)?;
     let mut reports: Vec<FrameReport> = ex.run(g)?.into_iter().collect();
     reports.extend(ex.finish()?);
-    let bytes = readback
-        .mapped()
-        .ok_or_else(|| Error::Graph("readback buffer is not host-visible".into()))?;
-    let v: &[f32] = bytemuck::cast_slice(bytes);
+    let v: &[f32] = bytemuck::cast_slice(readback.bytes()?);
     let coeffs = std::array::from_fn(|i| Vec3::new(v[4 * i], v[4 * i + 1], v[4 * i + 2]));
     Ok((coeffs, reports.pop().unwrap_or_default()))
 }

@@ -4,16 +4,14 @@
 //! shaders-glsl/common/lights.glsl.
 
 use crate::error::Result;
+use crate::frame::{MeshBuffers, Vertex, SHADOW_FORMAT};
 use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
 use crate::graph::{Graph, ImageHandle, LoadOp};
-use crate::render::resources::{MeshBuffers, Vertex, VERTEX_ATTRIBUTES};
 use crate::scene::LightSource;
 use ash::vk;
 use glam::camera::rh::{proj::vulkan as proj, view::look_at_mat4};
 use glam::{Mat4, Vec3, Vec4};
 use std::sync::Arc;
-
-pub const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// Each light's frustum holds the mesh's bounding sphere grown by this factor, so
 /// PCF taps at the rim stay inside the light's tile.
@@ -96,14 +94,10 @@ impl ShadowPass {
             &GraphicsDesc {
                 vertex: "shadow.vert",
                 fragment: "shadow.frag",
-                bindings: &[],
-                push_constant_bytes: 64,
                 color_formats: &[],
                 depth_format: Some(SHADOW_FORMAT),
-                vertex_layout: Some((
-                    std::mem::size_of::<Vertex>() as u32,
-                    &VERTEX_ATTRIBUTES[..1],
-                )),
+                // Positions only.
+                vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
                 cull_mode: vk::CullModeFlags::NONE,
             },
         )?;
@@ -125,18 +119,17 @@ impl ShadowPass {
             n => (n * resolution, resolution),
         };
         let mut atlas = g.create_image("shadow atlas", ImageDesc::new(w, h, SHADOW_FORMAT));
-        let mut p = g.add_pass("shadow maps");
-        p.depth_attachment(&mut atlas, LoadOp::Clear([1.0; 4]));
         let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
         let matrices: Vec<[f32; 16]> = views.iter().map(|v| v.view_proj.to_cols_array()).collect();
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            for (i, m) in matrices.iter().enumerate() {
-                cx.set_viewport(i as u32 * resolution, 0, resolution, resolution);
-                cx.push_constants(&pipe, m);
-                mesh.draw(cx);
-            }
-        });
+        g.simple_pass("shadow maps", &self.pipeline)
+            .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
+            .record(move |cx| {
+                for (i, m) in matrices.iter().enumerate() {
+                    cx.set_viewport(i as u32 * resolution, 0, resolution, resolution);
+                    cx.push_constants(&pipe, m);
+                    mesh.record_draw(cx);
+                }
+            });
         atlas
     }
 }

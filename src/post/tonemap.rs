@@ -1,8 +1,8 @@
 //! Exposure (EV stops) and the sRGB transfer function into an 8-bit target.
 
 use crate::error::Result;
-use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline, Sampler};
-use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
+use crate::gpu::{Context, GraphicsDesc, Pipeline, Sampler};
+use crate::graph::{Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -20,8 +20,6 @@ impl Tonemap {
             &GraphicsDesc {
                 vertex: "fullscreen.vert",
                 fragment: "tonemap.frag",
-                bindings: &[Binding::SampledImage],
-                push_constant_bytes: 4,
                 color_formats: &[LDR_FORMAT],
                 depth_format: None,
                 vertex_layout: None,
@@ -33,15 +31,10 @@ impl Tonemap {
 
     /// `hdr` × 2^exposure, sRGB-encoded, into `ldr`.
     pub fn pass(&self, g: &mut Graph, hdr: &ImageHandle, ldr: &mut ImageHandle, exposure: f32) {
-        let mut p = g.add_pass("tonemap");
-        let src = p.read(hdr, Access::FragmentSampled);
-        p.color_attachment(ldr, LoadOp::DontCare);
-        let (pipe, sampler) = (self.pipeline.clone(), self.sampler.clone());
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(&pipe, &[Descriptor::Sampled(src, &sampler)]);
-            cx.push_constants(&pipe, &exposure);
-            cx.draw(3, 1);
-        });
+        g.simple_pass("tonemap", &self.pipeline)
+            .sample(hdr, &self.sampler)
+            .color(ldr, LoadOp::DontCare)
+            .constants(&exposure)
+            .draw(3);
     }
 }

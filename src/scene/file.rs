@@ -309,10 +309,12 @@ pub struct Skin {
     /// (pre-/post-scatter texturing, GPU Gems 3 §14.5).
     pub mix: f32,
     pub kernel: Kernel,
-    /// Sum-of-Gaussians profile, variances strictly increasing.
-    pub profile: Vec<ProfileGaussian>,
-    /// Exactly [`REGION_COUNT`] regions.
-    pub regions: Vec<SpecularRegion>,
+    /// Sum-of-Gaussians profile, variances strictly increasing; `None`: the
+    /// skin model's published six-Gaussian profile (skin::profile).
+    pub profile: Option<Vec<ProfileGaussian>>,
+    /// Exactly [`REGION_COUNT`] regions; `None`: the skin model's defaults
+    /// (skin::specular).
+    pub regions: Option<Vec<SpecularRegion>>,
     pub occlusion: Occlusion,
     /// Correct blur widths for UV distortion with the stretch map (the paper's
     /// section II.B); off: one texels-per-mm constant for the whole mesh.
@@ -324,36 +326,12 @@ impl Default for Skin {
         Skin {
             mix: 0.5,
             kernel: Kernel::Deon7,
-            profile: default_profile(),
-            regions: default_regions(),
+            profile: None,
+            regions: None,
             occlusion: Occlusion::Raytrace,
             stretch_correction: true,
         }
     }
-}
-
-/// The six-Gaussian skin profile (`skin::profile::SKIN_TABLE`, GPU Gems 3 §14.4).
-pub fn default_profile() -> Vec<ProfileGaussian> {
-    crate::skin::profile::SKIN_TABLE
-        .iter()
-        .map(|&(variance_mm2, weights)| ProfileGaussian {
-            variance_mm2,
-            weights,
-        })
-        .collect()
-}
-
-/// The ten face regions at d'Eon & Luebke's fallback m = 0.3, ρs = 0.18
-/// (`skin::specular::default_regions`; no measured table could be cited).
-pub fn default_regions() -> Vec<SpecularRegion> {
-    crate::skin::specular::default_regions()
-        .iter()
-        .map(|r| SpecularRegion {
-            name: r.name.to_string(),
-            rho_s: r.rho_s,
-            m: r.m,
-        })
-        .collect()
 }
 
 /// Output transfer function.
@@ -674,49 +652,63 @@ pub const PROFILE_SUM_TOLERANCE: f32 = 0.01;
 impl Skin {
     fn validate(&self) -> Result<(), String> {
         in_range("skin.mix", self.mix, 0.0, 1.0)?;
-        if self.profile.is_empty() {
-            return Err("skin.profile is empty: give at least one Gaussian".into());
+        if let Some(profile) = &self.profile {
+            validate_profile(profile)?;
         }
-        let mut sums = [0.0f32; 3];
-        let mut previous: Option<f32> = None;
-        for (i, g) in self.profile.iter().enumerate() {
-            let key = format!("skin.profile[{i}]");
-            non_negative(&format!("{key}.variance_mm2"), g.variance_mm2)?;
-            if let Some(prev) = previous {
-                if g.variance_mm2 <= prev {
-                    return Err(format!(
-                        "{key}.variance_mm2 = {}: variances must increase strictly (the blur chain \
-                         blurs each level from the previous one by the difference)",
-                        g.variance_mm2
-                    ));
-                }
-            }
-            previous = Some(g.variance_mm2);
-            for (c, (sum, w)) in sums.iter_mut().zip(g.weights).enumerate() {
-                non_negative(&format!("{key}.weights[{c}]"), w)?;
-                *sum += w;
-            }
-        }
-        for (c, sum) in ["red", "green", "blue"].iter().zip(sums) {
-            if (sum - 1.0).abs() > PROFILE_SUM_TOLERANCE {
-                return Err(format!(
-                    "skin.profile: the {c} weights sum to {sum}, not 1 (±{PROFILE_SUM_TOLERANCE})"
-                ));
-            }
-        }
-        if self.regions.len() != REGION_COUNT {
-            return Err(format!(
-                "skin.regions has {} entries; it needs exactly {REGION_COUNT}",
-                self.regions.len()
-            ));
-        }
-        for (i, r) in self.regions.iter().enumerate() {
-            in_range(&format!("skin.regions[{i}].rho_s"), r.rho_s, 0.0, 1.0)?;
-            positive(&format!("skin.regions[{i}].m"), r.m)?;
-            in_range(&format!("skin.regions[{i}].m"), r.m, 0.0, 1.0)?;
+        if let Some(regions) = &self.regions {
+            validate_regions(regions)?;
         }
         Ok(())
     }
+}
+
+fn validate_profile(profile: &[ProfileGaussian]) -> Result<(), String> {
+    if profile.is_empty() {
+        return Err("skin.profile is empty: give at least one Gaussian".into());
+    }
+    let mut sums = [0.0f32; 3];
+    let mut previous: Option<f32> = None;
+    for (i, g) in profile.iter().enumerate() {
+        let key = format!("skin.profile[{i}]");
+        non_negative(&format!("{key}.variance_mm2"), g.variance_mm2)?;
+        if let Some(prev) = previous {
+            if g.variance_mm2 <= prev {
+                return Err(format!(
+                    "{key}.variance_mm2 = {}: variances must increase strictly (the blur chain \
+                     blurs each level from the previous one by the difference)",
+                    g.variance_mm2
+                ));
+            }
+        }
+        previous = Some(g.variance_mm2);
+        for (c, (sum, w)) in sums.iter_mut().zip(g.weights).enumerate() {
+            non_negative(&format!("{key}.weights[{c}]"), w)?;
+            *sum += w;
+        }
+    }
+    for (c, sum) in ["red", "green", "blue"].iter().zip(sums) {
+        if (sum - 1.0).abs() > PROFILE_SUM_TOLERANCE {
+            return Err(format!(
+                "skin.profile: the {c} weights sum to {sum}, not 1 (±{PROFILE_SUM_TOLERANCE})"
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn validate_regions(regions: &[SpecularRegion]) -> Result<(), String> {
+    if regions.len() != REGION_COUNT {
+        return Err(format!(
+            "skin.regions has {} entries; it needs exactly {REGION_COUNT}",
+            regions.len()
+        ));
+    }
+    for (i, r) in regions.iter().enumerate() {
+        in_range(&format!("skin.regions[{i}].rho_s"), r.rho_s, 0.0, 1.0)?;
+        positive(&format!("skin.regions[{i}].m"), r.m)?;
+        in_range(&format!("skin.regions[{i}].m"), r.m, 0.0, 1.0)?;
+    }
+    Ok(())
 }
 
 impl Render {
@@ -820,27 +812,10 @@ mod tests {
         assert_eq!(scene.mesh, None);
         assert_eq!(scene.environment.source, "sky");
         assert_eq!(scene.skin.mix, 0.5);
-        assert_eq!(scene.skin.profile.len(), 6);
-        assert_eq!(scene.skin.regions.len(), 10);
-        assert!(scene
-            .skin
-            .regions
-            .iter()
-            .all(|r| r.m == 0.3 && r.rho_s == 0.18));
+        assert_eq!(scene.skin.profile, None);
+        assert_eq!(scene.skin.regions, None);
         assert_eq!(scene.render.irradiance_resolution, 4096);
         assert_eq!(scene.render.gamma, Gamma::Srgb);
-    }
-
-    #[test]
-    fn default_profile_is_normalised_per_channel() {
-        // Independent check of the published table: each channel sums to 1.
-        let p = default_profile();
-        for c in 0..3 {
-            let sum: f32 = p.iter().map(|g| g.weights[c]).sum();
-            assert!((sum - 1.0).abs() < 1e-3, "channel {c}: {sum}");
-        }
-        let v: Vec<f32> = p.iter().map(|g| g.variance_mm2).collect();
-        assert_eq!(v, [0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41]);
     }
 
     #[test]
@@ -908,7 +883,7 @@ gamma = 2.2
         assert!(!s.lights[1].shadow);
         assert_eq!(s.skin.kernel, Kernel::Accurate);
         assert_eq!(s.skin.occlusion, Occlusion::Off);
-        assert_eq!(s.skin.profile.len(), 2);
+        assert_eq!(s.skin.profile.as_ref().map(Vec::len), Some(2));
         assert_eq!(s.render.gamma, Gamma::Power(2.2));
         assert_eq!(s.render.exposure, Some(-1.5));
 
@@ -1095,8 +1070,8 @@ gamma = 2.2
         regions.push(']');
         assert!(err(&regions).contains("skin.regions[7].m"));
         let fixed = parse(&regions.replace("m = 0 }", "m = 0.2 }")).unwrap();
-        assert_eq!(fixed.skin.regions[7].m, 0.2);
-        assert_eq!(fixed.skin.regions[9].name, "r9");
+        assert_eq!(fixed.skin.regions.as_ref().unwrap()[7].m, 0.2);
+        assert_eq!(fixed.skin.regions.as_ref().unwrap()[9].name, "r9");
     }
 
     #[test]

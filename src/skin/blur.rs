@@ -10,10 +10,9 @@
 use super::profile::{Kernel, Profile};
 use super::UV_FORMAT;
 use crate::error::Result;
-use crate::gpu::Buffer;
-use crate::gpu::{Binding, Context, Pipeline, Sampler};
+use crate::gpu::{Buffer, Context, Pipeline, Sampler};
 use crate::graph::upload::upload_buffer;
-use crate::graph::{Access, Descriptor, Graph, ImageHandle};
+use crate::graph::{Access, Graph, ImageHandle};
 use std::sync::Arc;
 
 #[repr(C)]
@@ -66,18 +65,7 @@ impl BlurChain {
             BlurKernel::Accurate => 0,
         };
         Ok(Self {
-            pipeline: Pipeline::compute(
-                ctx,
-                "blur.comp",
-                &[
-                    Binding::SampledImage,
-                    Binding::SampledImage,
-                    Binding::StorageImage,
-                    Binding::StorageImage,
-                    Binding::StorageBuffer,
-                ],
-                std::mem::size_of::<BlurPush>() as u32,
-            )?,
+            pipeline: Pipeline::compute(ctx, "blur.comp")?,
             taps: upload_buffer(
                 ctx,
                 "blur kernel",
@@ -143,35 +131,17 @@ impl BlurChain {
         sigma_mm: f32,
     ) {
         let (w, h) = (dst.0.desc.width, dst.0.desc.height);
-        let mut p = g.add_pass(name);
-        let si = p.read(src.0, Access::ComputeSampled);
-        let ss = p.read(src.1, Access::ComputeSampled);
-        let di = p.write(dst.0, Access::ComputeStorageWrite);
-        let ds = p.write(dst.1, Access::ComputeStorageWrite);
-        let (pipe, taps, sampler) = (
-            self.pipeline.clone(),
-            self.taps.clone(),
-            self.sampler.clone(),
-        );
-        let push = BlurPush {
-            dir,
-            sigma_mm,
-            tap_count: self.tap_count,
-        };
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_descriptors(
-                &pipe,
-                &[
-                    Descriptor::Sampled(si, &sampler),
-                    Descriptor::Sampled(ss, &sampler),
-                    Descriptor::StorageImage(di),
-                    Descriptor::StorageImage(ds),
-                    Descriptor::StaticStorage(&taps),
-                ],
-            );
-            cx.push_constants(&pipe, &push);
-            cx.dispatch_2d(w, h, (8, 8));
-        });
+        g.simple_pass(name, &self.pipeline)
+            .sample(src.0, &self.sampler)
+            .sample(src.1, &self.sampler)
+            .store(dst.0)
+            .store(dst.1)
+            .buffer(&self.taps)
+            .constants(&BlurPush {
+                dir,
+                sigma_mm,
+                tap_count: self.tap_count,
+            })
+            .dispatch([w, h, 1]);
     }
 }

@@ -10,10 +10,10 @@ pub mod specular;
 pub mod stretch;
 pub mod tables;
 
-use crate::error::Result;
-use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
-use crate::render::resources::{Vertex, VERTEX_ATTRIBUTES};
-use crate::scene::file::{Kernel as KernelChoice, Skin};
+use crate::error::{Error, Result};
+use crate::frame::Vertex;
+use crate::gpu::{Context, GraphicsDesc, Pipeline};
+use crate::scene::file::{Kernel as KernelChoice, Render, Skin, SpecularRegion};
 use crate::scene::mesh::Mesh;
 use ash::vk;
 use blur::BlurKernel;
@@ -25,10 +25,13 @@ use std::sync::Arc;
 /// coverage-premultiplied RGBA16F, as the design card fixes for the 4096² chain.
 pub const UV_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
-/// Settings of texture-space diffusion, from the scene's `[skin]` and `[render]`.
+/// Settings of the skin model, resolved once from the scene's `[skin]` and
+/// `[render]`: defaults filled in, checked against what the passes support.
 #[derive(Clone, Debug)]
 pub struct SkinSettings {
     pub profile: Profile,
+    /// KS parameters of the ten face regions (specular::REGION_NAMES order).
+    pub regions: Vec<SpecularRegion>,
     pub kernel: BlurKernel,
     /// Pre-scatter share of the albedo (d'Eon & Luebke §14.5: 0.5).
     pub mix: f32,
@@ -40,11 +43,10 @@ pub struct SkinSettings {
 }
 
 impl SkinSettings {
-    pub fn from_scene(skin: &Skin, resolution: u32) -> Self {
-        Self {
-            profile: Profile {
-                gaussians: skin
-                    .profile
+    pub fn resolve(skin: &Skin, render: &Render) -> Result<Self> {
+        let profile = match &skin.profile {
+            Some(p) => Profile {
+                gaussians: p
                     .iter()
                     .map(|g| Gaussian {
                         variance_mm2: g.variance_mm2,
@@ -52,14 +54,38 @@ impl SkinSettings {
                     })
                     .collect(),
             },
+            None => Profile::skin(),
+        };
+        if profile.gaussians.len() != 6 {
+            return Err(Error::Input(format!(
+                "skin.profile has {} Gaussians; the blur chain and final shading use six",
+                profile.gaussians.len()
+            )));
+        }
+        profile
+            .validate()
+            .map_err(|e| Error::Input(format!("skin profile: {e}")))?;
+        let regions = skin.regions.clone().unwrap_or_else(|| {
+            specular::default_regions()
+                .iter()
+                .map(|r| SpecularRegion {
+                    name: r.name.into(),
+                    rho_s: r.rho_s,
+                    m: r.m,
+                })
+                .collect()
+        });
+        Ok(Self {
+            profile,
+            regions,
             kernel: match skin.kernel {
                 KernelChoice::Deon7 => BlurKernel::Fixed(Kernel::deon7()),
                 KernelChoice::Accurate => BlurKernel::Accurate,
             },
             mix: skin.mix,
-            resolution,
+            resolution: render.irradiance_resolution,
             stretch_correction: skin.stretch_correction,
-        }
+        })
     }
 }
 
@@ -87,19 +113,15 @@ pub(crate) fn uv_pipeline(
     ctx: &Arc<Context>,
     vertex: &str,
     fragment: &str,
-    bindings: &[Binding],
-    push_constant_bytes: u32,
 ) -> Result<Arc<Pipeline>> {
     Pipeline::graphics(
         ctx,
         &GraphicsDesc {
             vertex,
             fragment,
-            bindings,
-            push_constant_bytes,
             color_formats: &[UV_FORMAT],
             depth_format: None,
-            vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+            vertex_layout: Some(Vertex::layout()),
             // UV charts may be mirrored: both windings are surface.
             cull_mode: vk::CullModeFlags::NONE,
         },

@@ -2,11 +2,11 @@
 //! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π, plus the
 //! KS specular of the lights and the environment.
 
+use super::tables::SpecularTables;
 use crate::error::Result;
-use crate::gpu::{Binding, Context, GraphicsDesc, Pipeline};
-use crate::graph::{Access, Descriptor, Graph, ImageHandle, LoadOp};
-use crate::render::forward::{ForwardInputs, DEPTH_FORMAT, HDR_FORMAT, SPECULAR_BINDINGS};
-use crate::render::resources::{Vertex, VERTEX_ATTRIBUTES};
+use crate::frame::{FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::graph::{Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -54,28 +54,14 @@ pub struct ShadePass {
 
 impl ShadePass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
-        // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
-        // specular environment, six blur levels, the specular bindings.
-        let mut bindings = vec![
-            Binding::UniformBuffer,
-            Binding::SampledImage,
-            Binding::SampledImage,
-            Binding::SampledImage,
-            Binding::StorageBuffer,
-            Binding::SampledImage,
-        ];
-        bindings.extend([Binding::SampledImage; 6]);
-        bindings.extend(SPECULAR_BINDINGS);
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
                 vertex: "mesh_lit.vert",
                 fragment: "skin.frag",
-                bindings: &bindings,
-                push_constant_bytes: std::mem::size_of::<ShadePush>() as u32,
                 color_formats: &[HDR_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
-                vertex_layout: Some((std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)),
+                vertex_layout: Some(Vertex::layout()),
                 cull_mode: vk::CullModeFlags::NONE,
             },
         )?;
@@ -86,46 +72,38 @@ impl ShadePass {
     pub fn pass(
         &self,
         g: &mut Graph,
-        inputs: &Arc<ForwardInputs>,
+        inputs: &FrameInputs,
+        tables: &SpecularTables,
         images: ShadeImages,
         settings: ShadeSettings,
         hdr: &mut ImageHandle,
     ) {
         let (w, h) = (hdr.desc.width, hdr.desc.height);
-        let mut depth = g.create_image("depth", crate::gpu::ImageDesc::new(w, h, DEPTH_FORMAT));
-        let mut p = g.add_pass("skin");
-        let refs: Vec<_> = images
-            .levels
-            .iter()
-            .map(|l| p.read(l, Access::FragmentSampled))
-            .collect();
-        let atlas = p.read(images.shadows, Access::FragmentSampled);
-        let env = p.read(images.specular_env, Access::FragmentSampled);
-        p.color_attachment(hdr, LoadOp::Load);
-        p.depth_attachment(&mut depth, LoadOp::Clear([1.0; 4]));
-        let (pipe, inp) = (self.pipeline.clone(), inputs.clone());
-        let push = ShadePush {
-            weights: settings.weights.map(|w| w.extend(0.0).into()),
-            mix_pre: settings.mix,
-            mode: settings.mode as u32,
-            roughness_map: u32::from(inputs.roughness_map),
-        };
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            let sampler = &inp.samplers.linear;
-            let mut d = vec![
-                Descriptor::StaticUniform(&inp.uniforms),
-                Descriptor::StaticSampled(&inp.albedo, sampler),
-                Descriptor::StaticSampled(&inp.normal, sampler),
-                Descriptor::Sampled(atlas, &inp.samplers.shadow),
-                Descriptor::StaticStorage(&inp.transfer),
-                Descriptor::Sampled(env, sampler),
-            ];
-            d.extend(refs.iter().map(|&r| Descriptor::Sampled(r, sampler)));
-            d.extend(inp.specular_descriptors());
-            cx.push_descriptors(&pipe, &d);
-            cx.push_constants(&pipe, &push);
-            inp.mesh.draw(cx);
-        });
+        let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
+        let s = &inputs.samplers;
+        // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
+        // specular environment, six blur levels, the specular bindings.
+        let mut pass = g
+            .simple_pass("skin", &self.pipeline)
+            .uniform(&inputs.uniforms)
+            .texture(&inputs.albedo, &s.linear)
+            .texture(&inputs.normal, &s.linear)
+            .sample(images.shadows, &s.shadow)
+            .buffer(&inputs.transfer)
+            .sample(images.specular_env, &s.linear);
+        for level in images.levels {
+            pass = pass.sample(level, &s.linear);
+        }
+        let pass = tables
+            .bind(pass, inputs)
+            .color(hdr, LoadOp::Load)
+            .depth(&mut depth, LoadOp::Clear([1.0; 4]))
+            .constants(&ShadePush {
+                weights: settings.weights.map(|w| w.extend(0.0).into()),
+                mix_pre: settings.mix,
+                mode: settings.mode as u32,
+                roughness_map: u32::from(inputs.roughness_map),
+            });
+        inputs.mesh.draw(pass);
     }
 }

@@ -5,8 +5,8 @@
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::gpu::{Context, ImageDesc, Pipeline};
+use crate::frame::MeshBuffers;
 use crate::graph::{Graph, ImageHandle, LoadOp};
-use crate::render::resources::MeshBuffers;
 use std::sync::Arc;
 
 pub struct StretchPass {
@@ -16,7 +16,7 @@ pub struct StretchPass {
 impl StretchPass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
         Ok(Self {
-            pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag", &[], 4)?,
+            pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag")?,
         })
     }
 
@@ -24,20 +24,16 @@ impl StretchPass {
     pub fn pass(
         &self,
         g: &mut Graph,
-        mesh: &Arc<MeshBuffers>,
+        mesh: &MeshBuffers,
         resolution: u32,
         constant: Option<f32>,
     ) -> ImageHandle {
         let mut out = g.create_image("stretch", ImageDesc::new(resolution, resolution, UV_FORMAT));
-        let mut p = g.add_pass("stretch");
-        p.color_attachment(&mut out, LoadOp::Clear([0.0; 4]));
-        let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
-        let constant = constant.unwrap_or(0.0);
-        p.record(move |cx| {
-            cx.bind(&pipe);
-            cx.push_constants(&pipe, &constant);
-            mesh.draw(cx);
-        });
+        let pass = g
+            .simple_pass("stretch", &self.pipeline)
+            .color(&mut out, LoadOp::Clear([0.0; 4]))
+            .constants(&constant.unwrap_or(0.0));
+        mesh.draw(pass);
         out
     }
 }

@@ -5,8 +5,9 @@
 use super::specular;
 use crate::error::Result;
 use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
+use crate::frame::FrameInputs;
 use crate::graph::upload::{upload_buffer, upload_texture};
-use crate::graph::Access;
+use crate::graph::{Access, SimplePass};
 use crate::scene::file::SpecularRegion;
 use ash::vk;
 use std::sync::Arc;
@@ -85,5 +86,18 @@ impl SpecularTables {
                 nearest
             },
         })
+    }
+
+    /// Declares the six bindings of common/ks_specular.glsl, in its order: the
+    /// Beckmann and albedo tables, the region, intensity and roughness maps, the
+    /// region parameters.
+    pub fn bind<'g>(&self, pass: SimplePass<'g>, inputs: &FrameInputs) -> SimplePass<'g> {
+        let s = &inputs.samplers;
+        pass.texture(&self.beckmann, &self.sampler)
+            .texture(&self.albedo, &self.sampler)
+            .texture(&inputs.regions, &s.nearest)
+            .texture(&inputs.specular, &s.linear)
+            .texture(&inputs.roughness, &s.linear)
+            .buffer(&self.regions)
     }
 }

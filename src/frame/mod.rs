@@ -1,0 +1,40 @@
+//! The frame's inputs on the GPU: the vocabulary every pass shares. Vertex layout,
+//! mesh buffers, uploaded textures and environment, target formats, per-frame
+//! uniforms and samplers. Below the passes (`skin/`, `light/`, `post/`), above
+//! `scene/` (what it uploads) and `graph/`.
+
+mod formats;
+mod mesh;
+mod samplers;
+mod textures;
+mod uniforms;
+
+pub use formats::{DEPTH_FORMAT, HDR_FORMAT, SHADOW_FORMAT};
+pub use mesh::{MeshBuffers, Vertex, VERTEX_ATTRIBUTES};
+pub use samplers::Samplers;
+pub use textures::{upload_env, upload_rgba8};
+pub use uniforms::{FrameUniforms, MAX_LIGHTS};
+
+use crate::gpu::{Buffer, Image, Sampler};
+use std::sync::Arc;
+
+/// What every frame reads that does not change during a render.
+pub struct FrameInputs {
+    /// [`FrameUniforms`]: camera, lights, environment rotation, exposure.
+    pub uniforms: Arc<Buffer>,
+    pub mesh: Arc<MeshBuffers>,
+    pub albedo: Arc<Image>,
+    pub normal: Arc<Image>,
+    /// Per-vertex SH transfer, 9 floats per vertex (light::occlusion).
+    pub transfer: Arc<Buffer>,
+    /// Specular intensity, roughness and face-region maps (read by the specular term).
+    pub specular: Arc<Image>,
+    pub roughness: Arc<Image>,
+    pub regions: Arc<Image>,
+    /// Whether the scene gave a roughness map (else the regions' m is used).
+    pub roughness_map: bool,
+    pub env: Arc<Image>,
+    /// Linear where the device filters RGBA32F, else nearest.
+    pub env_sampler: Arc<Sampler>,
+    pub samplers: Arc<Samplers>,
+}

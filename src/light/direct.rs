@@ -1,0 +1,78 @@
+//! The mesh in screen space with direct diffuse shading and no scattering
+//! (`--view direct`), or its occlusion (`--view occlusion`): Σ L_i·T_i per vertex
+//! plus the shadowed lights, for comparison with texture-space diffusion.
+
+use crate::error::Result;
+use crate::frame::{FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+/// Which quantity the pass shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectView {
+    /// Direct diffuse shading.
+    Shading,
+    /// The transfer's DC term relative to open sky (1 = unoccluded).
+    Occlusion,
+}
+
+pub struct DirectPass {
+    shading: Arc<Pipeline>,
+    occlusion: Arc<Pipeline>,
+}
+
+impl DirectPass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let lit = |fragment| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    vertex: "mesh_lit.vert",
+                    fragment,
+                    color_formats: &[HDR_FORMAT],
+                    depth_format: Some(DEPTH_FORMAT),
+                    vertex_layout: Some(Vertex::layout()),
+                    // Scanned meshes are not reliably closed or consistently wound.
+                    cull_mode: vk::CullModeFlags::NONE,
+                },
+            )
+        };
+        Ok(Self {
+            shading: lit("forward.frag")?,
+            occlusion: lit("occlusion.frag")?,
+        })
+    }
+
+    /// Draws the mesh over `hdr`; `sh`: the environment's coefficients
+    /// (light::sh_pass); `shadows`: the lights' shadow atlas (light::shadow).
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        view: DirectView,
+        inputs: &FrameInputs,
+        sh: &BufferHandle,
+        shadows: &ImageHandle,
+        hdr: &mut ImageHandle,
+    ) {
+        let (pipeline, name) = match view {
+            DirectView::Shading => (&self.shading, "direct"),
+            DirectView::Occlusion => (&self.occlusion, "occlusion"),
+        };
+        let (w, h) = (hdr.desc.width, hdr.desc.height);
+        let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
+        let s = &inputs.samplers;
+        let pass = g
+            .simple_pass(name, pipeline)
+            .uniform(&inputs.uniforms)
+            .texture(&inputs.albedo, &s.linear)
+            .texture(&inputs.normal, &s.linear)
+            .read_buffer(sh)
+            .buffer(&inputs.transfer)
+            .sample(shadows, &s.shadow)
+            .color(hdr, LoadOp::Load)
+            .depth(&mut depth, LoadOp::Clear([1.0; 4]));
+        inputs.mesh.draw(pass);
+    }
+}

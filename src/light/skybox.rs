@@ -1,0 +1,40 @@
+//! The environment seen through the camera, behind the head.
+
+use crate::error::Result;
+use crate::frame::{FrameInputs, HDR_FORMAT};
+use crate::gpu::{Context, GraphicsDesc, Pipeline};
+use crate::graph::{Graph, ImageHandle, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+pub struct SkyboxPass {
+    pipeline: Arc<Pipeline>,
+}
+
+impl SkyboxPass {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "fullscreen.vert",
+                fragment: "background.frag",
+                color_formats: &[HDR_FORMAT],
+                depth_format: None,
+                vertex_layout: None,
+                cull_mode: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// Clears `hdr` to the environment behind the camera.
+    pub fn pass(&self, g: &mut Graph, inputs: &FrameInputs, hdr: &mut ImageHandle) {
+        let size = [hdr.desc.width as f32, hdr.desc.height as f32];
+        g.simple_pass("background", &self.pipeline)
+            .uniform(&inputs.uniforms)
+            .texture(&inputs.env, &inputs.env_sampler)
+            .color(hdr, LoadOp::Clear([0.0; 4]))
+            .constants(&size)
+            .draw(3);
+    }
+}

@@ -1,0 +1,316 @@
+//! One frame of the `render` command: the GPU state shared by every frame of a
+//! render (uploaded scene, pipelines) and the frame graph, pass by pass, for the
+//! final image or a debug view.
+
+use super::View;
+use crate::error::{Error, Result};
+use crate::frame::{
+    upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, HDR_FORMAT,
+    MAX_LIGHTS,
+};
+use crate::gpu::{Context, ImageDesc};
+use crate::graph::upload::upload_buffer;
+use crate::graph::{Access, Graph, ImageHandle};
+use crate::light::direct::{DirectPass, DirectView};
+use crate::light::prefilter::PrefilterPass;
+use crate::light::sh_pass::{ShBuffers, ShPasses};
+use crate::light::shadow::{ShadowPass, ShadowView};
+use crate::light::skybox::SkyboxPass;
+use crate::post::tonemap::{Tonemap, LDR_FORMAT};
+use crate::scene::file::Occlusion;
+use crate::scene::{LightSource, Scene};
+use crate::skin::blur::BlurChain;
+use crate::skin::irradiance::IrradiancePass;
+use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
+use crate::skin::stretch::StretchPass;
+use crate::skin::tables::SpecularTables;
+use crate::skin::{mean_stretch, SkinSettings};
+use ash::vk;
+use std::sync::Arc;
+
+/// The shadow projection of each light the frame uses (`None`: unshadowed).
+fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
+    let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
+    let (centre, radius) = (0.5 * (lo + hi), 0.5 * lo.distance(hi));
+    let res = scene.file.render.shadow_resolution;
+    if scene.lights.len() > MAX_LIGHTS {
+        log::warn!(
+            "only the first {MAX_LIGHTS} of {} lights are used",
+            scene.lights.len()
+        );
+    }
+    scene
+        .lights
+        .iter()
+        .take(MAX_LIGHTS)
+        .map(|l| {
+            let view = l
+                .shadow
+                .then(|| ShadowView::fit(l.source, centre, radius, res))
+                .flatten();
+            if l.shadow && view.is_none() {
+                log::warn!(
+                    "{:?} is inside the mesh's bounding sphere (radius {radius:.0} mm): \
+                     one shadow map cannot hold every direction; it casts no shadow",
+                    l.source
+                );
+            }
+            view
+        })
+        .collect()
+}
+
+/// The frame's uniforms: camera, environment rotation and intensity, lights and
+/// their shadow projections (`views`, from [`shadow_views`]), exposure.
+fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> FrameUniforms {
+    let vp = scene.camera.view_projection(aspect);
+    let env = &scene.file.environment;
+    let mut u = FrameUniforms {
+        view_proj: vp.to_cols_array_2d(),
+        inv_view_proj: vp.inverse().to_cols_array_2d(),
+        camera_pos: scene.camera.position.extend(1.0).into(),
+        light_vec: [[0.0; 4]; MAX_LIGHTS],
+        light_color: [[0.0; 4]; MAX_LIGHTS],
+        light_shadow: [[[0.0; 4]; 4]; MAX_LIGHTS],
+        env: [
+            env.rotation_deg.to_radians(),
+            env.intensity,
+            0.0,
+            if scene.file.skin.occlusion == Occlusion::Off {
+                0.0
+            } else {
+                1.0
+            },
+        ],
+        params: [scene.exposure(), 0.0, 0.0, 0.0],
+    };
+    let tiles = views.iter().flatten().count();
+    let mut tile = 0;
+    for (i, (l, view)) in scene.lights.iter().zip(views).enumerate() {
+        u.light_vec[i] = match l.source {
+            LightSource::Directional(d) => d.extend(0.0),
+            LightSource::Point(p) => p.extend(1.0),
+        }
+        .into();
+        u.light_color[i] = l.irradiance.extend(0.0).into();
+        if let Some(v) = view {
+            u.light_color[i][3] = v.texel_mm;
+            u.light_shadow[i] = v.atlas_matrix(tile, tiles).to_cols_array_2d();
+            tile += 1;
+        }
+        u.env[2] = (i + 1) as f32;
+    }
+    u
+}
+
+/// GPU state shared by every frame of a render: uploaded scene and pipelines.
+pub(super) struct Frame {
+    inputs: FrameInputs,
+    tables: SpecularTables,
+    skybox: SkyboxPass,
+    direct: DirectPass,
+    stretch: StretchPass,
+    irradiance: IrradiancePass,
+    blur: BlurChain,
+    shade: ShadePass,
+    shadow: ShadowPass,
+    /// The shadowed lights' projections, in atlas tile order.
+    shadow_views: Vec<ShadowView>,
+    shadow_resolution: u32,
+    prefilter: PrefilterPass,
+    tonemap: Tonemap,
+    sh: ShPasses,
+    sh_buffers: ShBuffers,
+    skin: SkinSettings,
+    constant_stretch: Option<f32>,
+    exposure: f32,
+}
+
+impl Frame {
+    pub(super) fn new(ctx: &Arc<Context>, scene: &Scene, skin: SkinSettings) -> Result<Self> {
+        let (w, h) = (scene.file.render.width, scene.file.render.height);
+        let samplers = Arc::new(Samplers::new(ctx)?);
+        let views = shadow_views(scene);
+        let shadow_res = scene.file.render.shadow_resolution;
+        let tiles = views.iter().flatten().count() as u32;
+        super::check_target(&ctx.info, shadow_res * tiles.max(1), shadow_res).map_err(|e| {
+            Error::Input(format!(
+                "shadow atlas of {tiles} light(s) at render.shadow_resolution = {shadow_res}: {e}"
+            ))
+        })?;
+        let uniforms = frame_uniforms(scene, w as f32 / h as f32, &views);
+        let inputs = FrameInputs {
+            uniforms: upload_buffer(
+                ctx,
+                "frame uniforms",
+                bytemuck::bytes_of(&uniforms),
+                Access::UniformRead,
+            )?,
+            mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
+            albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
+            normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
+            transfer: upload_buffer(
+                ctx,
+                "transfer",
+                bytemuck::cast_slice(
+                    &crate::light::transfer_for(ctx, &scene.mesh, scene.file.skin.occlusion)?
+                        .coeffs,
+                ),
+                Access::ShaderBufferRead,
+            )?,
+            specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
+            roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
+            regions: upload_rgba8(ctx, "region map", &scene.regions)?,
+            roughness_map: scene.file.textures.roughness.is_some(),
+            env: upload_env(ctx, &scene.env)?,
+            env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
+                samplers.linear.clone()
+            } else {
+                samplers.nearest.clone()
+            },
+            samplers: samplers.clone(),
+        };
+        let tables = SpecularTables::new(
+            ctx,
+            &skin.regions,
+            samplers.linear.clone(),
+            samplers.nearest.clone(),
+        )?;
+        let constant_stretch =
+            (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, skin.resolution));
+        Ok(Self {
+            tables,
+            skybox: SkyboxPass::new(ctx)?,
+            direct: DirectPass::new(ctx)?,
+            stretch: StretchPass::new(ctx)?,
+            irradiance: IrradiancePass::new(ctx)?,
+            blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
+            shade: ShadePass::new(ctx)?,
+            shadow: ShadowPass::new(ctx)?,
+            shadow_views: views.into_iter().flatten().collect(),
+            shadow_resolution: scene.file.render.shadow_resolution,
+            prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
+            tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
+            sh: ShPasses::new(ctx, samplers.nearest.clone())?,
+            sh_buffers: ShBuffers::new(
+                ctx,
+                &inputs.env,
+                scene.file.environment.rotation_deg,
+                scene.file.environment.intensity,
+            )?,
+            inputs,
+            skin,
+            constant_stretch,
+            exposure: scene.exposure(),
+        })
+    }
+
+    /// The occlusion view shows a ratio in [0, 1]: no exposure.
+    pub(super) fn exposure_for(&self, view: View) -> f32 {
+        if view == View::Occlusion {
+            0.0
+        } else {
+            self.exposure
+        }
+    }
+
+    /// Builds the frame graph; returns the image to read back (and its size)
+    /// for `view`, and for screen views the tone-mapped 8-bit image.
+    /// `first`: the render's first frame (it also prefilters the environment).
+    pub(super) fn graph(
+        &self,
+        g: &mut Graph,
+        view: View,
+        (w, h): (u32, u32),
+        first: bool,
+    ) -> (ImageHandle, Option<ImageHandle>) {
+        let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
+        let sh = self.sh.passes(
+            g,
+            &self.inputs.env,
+            &self.sh_buffers,
+            Access::FragmentBufferRead,
+        );
+        if view == View::Prefiltered {
+            return (self.prefilter.pass(g, &self.inputs.env, first), None);
+        }
+        let shadows = self.shadow.pass(
+            g,
+            &self.inputs.mesh,
+            &self.shadow_views,
+            self.shadow_resolution,
+        );
+        if let View::Direct | View::Occlusion = view {
+            let direct = match view {
+                View::Direct => DirectView::Shading,
+                _ => DirectView::Occlusion,
+            };
+            self.skybox.pass(g, &self.inputs, &mut hdr);
+            self.direct
+                .pass(g, direct, &self.inputs, &sh, &shadows, &mut hdr);
+        } else {
+            let res = self.skin.resolution;
+            let mesh = &self.inputs.mesh;
+            let stretch = self.stretch.pass(g, mesh, res, self.constant_stretch);
+            let irradiance = self.irradiance.pass(
+                g,
+                &self.inputs,
+                &self.tables,
+                &sh,
+                &shadows,
+                res,
+                self.skin.mix,
+            );
+            if view == View::Stretch {
+                return (stretch, None);
+            }
+            if view == View::Irradiance {
+                return (irradiance, None);
+            }
+            let levels = self
+                .blur
+                .chain(g, &irradiance, &stretch, &self.skin.profile);
+            if let View::Blur(k) = view {
+                let mut irr = levels.irradiance;
+                return (irr.swap_remove(k as usize - 1), None);
+            }
+            let specular_env = self.prefilter.pass(g, &self.inputs.env, first);
+            self.skybox.pass(g, &self.inputs, &mut hdr);
+            let weights: Vec<_> = self
+                .skin
+                .profile
+                .gaussians
+                .iter()
+                .map(|g| g.weights)
+                .collect();
+            let weights: [glam::Vec3; 6] = weights.try_into().unwrap_or([glam::Vec3::ZERO; 6]);
+            let mode = match view {
+                View::Diffuse => ShadeMode::Diffuse,
+                View::Specular => ShadeMode::Specular,
+                _ => ShadeMode::Full,
+            };
+            let settings = ShadeSettings {
+                weights,
+                mix: self.skin.mix,
+                mode,
+            };
+            self.shade.pass(
+                g,
+                &self.inputs,
+                &self.tables,
+                ShadeImages {
+                    levels: &levels.irradiance,
+                    shadows: &shadows,
+                    specular_env: &specular_env,
+                },
+                settings,
+                &mut hdr,
+            );
+        }
+        let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
+        self.tonemap
+            .pass(g, &hdr, &mut ldr, self.exposure_for(view));
+        (hdr, Some(ldr))
+    }
+}
+
