@@ -2,6 +2,7 @@
 //! (Yang, Wang & Zuo 2012; d'Eon & Luebke, GPU Gems 3 ch. 14) on raw Vulkan,
 //! measured pass by pass.
 
+pub mod assets;
 pub mod error;
 pub mod frame;
 pub mod gpu;

@@ -17,7 +17,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "graph"],
     &["profile"],
     &["gpu"],
-    &["error"],
+    &["error", "assets"],
 ];
 
 fn layer_of(module: &str) -> usize {
