@@ -35,8 +35,10 @@ pub enum Error {
     /// Bad user input (files, sizes, options): exit status 2.
     #[error("{0}")]
     Input(String),
+    /// Bad input found by a higher layer's loader (scene file, mesh, texture,
+    /// environment map), as its own typed error; those layers convert into it.
     #[error(transparent)]
-    Scene(#[from] crate::scene::file::SceneError),
+    BadInput(Box<dyn std::error::Error + Send + Sync>),
     #[error(transparent)]
     Env(#[from] crate::light::envmap::EnvError),
     #[error("{path}: {source}")]
@@ -53,7 +55,7 @@ impl Error {
             Error::Input(_)
             | Error::Io { .. }
             | Error::DeviceNotFound { .. }
-            | Error::Scene(_)
+            | Error::BadInput(_)
             | Error::Env(_) => 2,
             _ => 1,
         }

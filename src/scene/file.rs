@@ -41,6 +41,12 @@ pub enum SceneError {
     Texture { path: PathBuf, message: String },
 }
 
+impl From<SceneError> for crate::error::Error {
+    fn from(e: SceneError) -> Self {
+        crate::error::Error::BadInput(Box::new(e))
+    }
+}
+
 impl SceneError {
     pub(crate) fn invalid(path: &Path, message: impl AsRef<str>) -> SceneError {
         SceneError::Invalid {
