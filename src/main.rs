@@ -278,7 +278,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 width,
                 height,
             };
-            let hdr = dermis::render::output::Format::of(&out)? == dermis::render::output::Format::Exr;
+            let hdr =
+                dermis::render::output::Format::of(&out)? == dermis::render::output::Format::Exr;
             let output = render(&RenderOptions {
                 scene: overrides.apply(file)?,
                 frames,

@@ -215,3 +215,72 @@ fn sync_validation_catches_a_missing_barrier() {
         "expected a synchronization hazard, got: {messages:#?}"
     );
 }
+
+#[test]
+fn simple_pass_declarations_are_checked_against_the_shader() {
+    common::with_gpu(|ctx| {
+        let scene = TestScene::new(ctx).unwrap();
+        let desc = ImageDesc::new(16, 16, HALF);
+        let compile = |build: &dyn Fn(&mut Graph)| {
+            let mut g = Graph::new();
+            build(&mut g);
+            let mut ex = Executor::new(ctx, 1).unwrap();
+            ex.compile(g).err().map(|e| e.to_string())
+        };
+        // test_blur.comp: binding 0 sampled, binding 1 storage, 16 bytes of constants.
+        let push = dermis::testscene::BlurPush {
+            dir: [1, 0],
+            radius: 1,
+            sigma: 1.0,
+        };
+        let right = compile(&|g| {
+            let mut src = g.create_image("src", desc);
+            g.simple_pass("fill", &scene.pattern)
+                .store(&mut src)
+                .constants(&[16u32, 16])
+                .dispatch([16, 16, 1]);
+            let mut dst = g.create_image("dst", desc);
+            g.simple_pass("blur", &scene.blur)
+                .sample(&src, &scene.sampler)
+                .store(&mut dst)
+                .constants(&push)
+                .dispatch([16, 16, 1]);
+        });
+        assert_eq!(right, None);
+        let swapped = compile(&|g| {
+            let mut src = g.create_image("src", desc);
+            g.simple_pass("fill", &scene.pattern)
+                .store(&mut src)
+                .constants(&[16u32, 16])
+                .dispatch([16, 16, 1]);
+            let mut dst = g.create_image("dst", desc);
+            g.simple_pass("swapped", &scene.blur)
+                .store(&mut dst)
+                .sample(&src, &scene.sampler)
+                .constants(&push)
+                .dispatch([16, 16, 1]);
+        })
+        .expect("binding types are checked");
+        assert!(swapped.contains("\"swapped\""), "{swapped}");
+        assert!(
+            swapped.contains("binding 0 is declared STORAGE_IMAGE"),
+            "{swapped}"
+        );
+        let short = compile(&|g| {
+            let mut src = g.create_image("src", desc);
+            g.simple_pass("fill", &scene.pattern)
+                .store(&mut src)
+                .constants(&[16u32])
+                .dispatch([16, 16, 1]);
+        })
+        .expect("constant sizes are checked");
+        assert!(short.contains("pushes 4 bytes"), "{short}");
+        let missing = compile(&|g| {
+            g.simple_pass("empty", &scene.pattern)
+                .constants(&[16u32, 16])
+                .dispatch([16, 16, 1]);
+        })
+        .expect("missing bindings are checked");
+        assert!(missing.contains("declares 0 bindings"), "{missing}");
+    });
+}

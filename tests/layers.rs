@@ -125,7 +125,11 @@ fn module_and_file(path: &Path) -> (String, Option<String>) {
 fn imports_only_run_downward() {
     let mut files = Vec::new();
     rust_files(&src(), &mut files);
-    assert!(files.len() > 40, "found only {} files under src/", files.len());
+    assert!(
+        files.len() > 40,
+        "found only {} files under src/",
+        files.len()
+    );
     let mut wrong = Vec::new();
     let mut arrows = 0;
     for path in &files {
@@ -153,8 +157,15 @@ fn imports_only_run_downward() {
             }
         }
     }
-    assert!(arrows > 50, "only {arrows} import arrows found: is the scan broken?");
-    assert!(wrong.is_empty(), "imports against the layers:\n{}", wrong.join("\n"));
+    assert!(
+        arrows > 50,
+        "only {arrows} import arrows found: is the scan broken?"
+    );
+    assert!(
+        wrong.is_empty(),
+        "imports against the layers:\n{}",
+        wrong.join("\n")
+    );
 }
 
 #[test]
@@ -213,7 +224,11 @@ fn files_of_a_module_import_each_other_without_circles() {
             circles.extend(found.into_iter().map(|c| format!("{module}: {c}")));
         }
     }
-    assert!(circles.is_empty(), "import circles:\n{}", circles.join("\n"));
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
 }
 
 #[test]

@@ -4,11 +4,11 @@
 
 mod common;
 
-use dermis::gpu::{Context, ImageDesc, Sampler};
-use dermis::graph::upload::Readback;
-use dermis::graph::upload::upload_texture;
-use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::frame::MeshBuffers;
+use dermis::gpu::{Context, ImageDesc, Sampler};
+use dermis::graph::upload::upload_texture;
+use dermis::graph::upload::Readback;
+use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::scene::mesh::Mesh;
 use dermis::skin::blur::{BlurChain, BlurKernel};
 use dermis::skin::profile::{gaussian, Kernel, Profile};

@@ -3,9 +3,9 @@
 
 mod common;
 
+use dermis::graph::upload::Readback;
 use dermis::graph::{Clock, Executor, Graph};
 use dermis::profile::FrameReport;
-use dermis::graph::upload::Readback;
 use dermis::testscene::TestScene;
 
 fn frames(clock: Clock) -> Vec<FrameReport> {

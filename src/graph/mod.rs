@@ -16,8 +16,8 @@ pub mod upload;
 pub use access::{Access, AccessInfo};
 pub use execute::{Clock, Compiled, Executor};
 pub use pass_cx::{Descriptor, PassCx, ResolvedImage};
-pub use simple::SimplePass;
 pub use plan::{Barrier, Plan, PlannedPass, PlannedResource, PoolState};
+pub use simple::SimplePass;
 
 use crate::gpu::{Buffer, Image, ImageDesc};
 use ash::vk;

@@ -72,7 +72,8 @@ impl<'a> PassCx<'a> {
         };
     }
 
-    pub fn push_descriptors(&self, p: &Pipeline, descriptors: &[Descriptor]) {
+    /// Pushes set 0: (binding number, descriptor) pairs.
+    pub fn push_descriptors(&self, p: &Pipeline, descriptors: &[(u32, Descriptor)]) {
         let image = |view, sampler: Option<&Sampler>, layout| vk::DescriptorImageInfo {
             sampler: sampler.map_or(vk::Sampler::null(), |s| s.raw),
             image_view: view,
@@ -84,53 +85,55 @@ impl<'a> PassCx<'a> {
             range: vk::WHOLE_SIZE,
         };
         let read_only = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-        // (type, image info, buffer info) per binding, in binding order.
+        // (binding, type, image info, buffer info) per descriptor.
         let infos: Vec<_> = descriptors
             .iter()
-            .map(|d| match *d {
-                Descriptor::StorageImage(r) => (
-                    vk::DescriptorType::STORAGE_IMAGE,
-                    Some(image(self.image(r).view, None, vk::ImageLayout::GENERAL)),
-                    None,
-                ),
-                Descriptor::Sampled(r, s) => (
-                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                    Some(image(self.image(r).view, Some(s), read_only)),
-                    None,
-                ),
-                Descriptor::StaticSampled(i, s) => (
-                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                    Some(image(i.view, Some(s), read_only)),
-                    None,
-                ),
-                Descriptor::Uniform(b) => (
-                    vk::DescriptorType::UNIFORM_BUFFER,
-                    None,
-                    Some(buffer(self.buffer(b))),
-                ),
-                Descriptor::Storage(b) => (
-                    vk::DescriptorType::STORAGE_BUFFER,
-                    None,
-                    Some(buffer(self.buffer(b))),
-                ),
-                Descriptor::StaticUniform(b) => (
-                    vk::DescriptorType::UNIFORM_BUFFER,
-                    None,
-                    Some(buffer(b.raw)),
-                ),
-                Descriptor::StaticStorage(b) => (
-                    vk::DescriptorType::STORAGE_BUFFER,
-                    None,
-                    Some(buffer(b.raw)),
-                ),
+            .map(|(binding, d)| {
+                let (ty, img, buf) = match *d {
+                    Descriptor::StorageImage(r) => (
+                        vk::DescriptorType::STORAGE_IMAGE,
+                        Some(image(self.image(r).view, None, vk::ImageLayout::GENERAL)),
+                        None,
+                    ),
+                    Descriptor::Sampled(r, s) => (
+                        vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                        Some(image(self.image(r).view, Some(s), read_only)),
+                        None,
+                    ),
+                    Descriptor::StaticSampled(i, s) => (
+                        vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                        Some(image(i.view, Some(s), read_only)),
+                        None,
+                    ),
+                    Descriptor::Uniform(b) => (
+                        vk::DescriptorType::UNIFORM_BUFFER,
+                        None,
+                        Some(buffer(self.buffer(b))),
+                    ),
+                    Descriptor::Storage(b) => (
+                        vk::DescriptorType::STORAGE_BUFFER,
+                        None,
+                        Some(buffer(self.buffer(b))),
+                    ),
+                    Descriptor::StaticUniform(b) => (
+                        vk::DescriptorType::UNIFORM_BUFFER,
+                        None,
+                        Some(buffer(b.raw)),
+                    ),
+                    Descriptor::StaticStorage(b) => (
+                        vk::DescriptorType::STORAGE_BUFFER,
+                        None,
+                        Some(buffer(b.raw)),
+                    ),
+                };
+                (*binding, ty, img, buf)
             })
             .collect();
         let writes: Vec<_> = infos
             .iter()
-            .enumerate()
-            .map(|(binding, (ty, img, buf))| {
+            .map(|(binding, ty, img, buf)| {
                 let w = vk::WriteDescriptorSet::default()
-                    .dst_binding(binding as u32)
+                    .dst_binding(*binding)
                     .descriptor_type(*ty);
                 match (img, buf) {
                     (Some(i), _) => w.image_info(std::slice::from_ref(i)),
@@ -387,4 +390,3 @@ impl<'a> PassCx<'a> {
         };
     }
 }
-

@@ -218,8 +218,15 @@ impl<'g> SimplePass<'g> {
         }
         pass.record(move |cx| {
             cx.bind(&pipeline);
-            if !bindings.is_empty() {
-                let d: Vec<Descriptor> = bindings.iter().map(Bound::descriptor).collect();
+            // Bindings the shader leaves unused (gaps in its layout) are not written.
+            let d: Vec<(u32, Descriptor)> = bindings
+                .iter()
+                .zip(&pipeline.interface.bindings)
+                .enumerate()
+                .filter(|(_, (_, ty))| ty.is_some())
+                .map(|(i, (b, _))| (i as u32, b.descriptor()))
+                .collect();
+            if !d.is_empty() {
                 cx.push_descriptors(&pipeline, &d);
             }
             if !constants.is_empty() {
@@ -234,7 +241,9 @@ impl<'g> SimplePass<'g> {
 fn check(pipeline: &Pipeline, bindings: &[Bound], constant_bytes: Option<usize>) -> Vec<String> {
     let layout = &pipeline.interface;
     let mut errors = Vec::new();
-    if bindings.len() != layout.bindings.len() {
+    // The declaration may name bindings past the shader's last, or in its gaps,
+    // that the shader does not use (one declaration for several shaders).
+    if bindings.len() < layout.bindings.len() {
         errors.push(format!(
             "declares {} bindings; the shader has {}",
             bindings.len(),
@@ -242,7 +251,7 @@ fn check(pipeline: &Pipeline, bindings: &[Bound], constant_bytes: Option<usize>)
         ));
     }
     for (i, (b, ty)) in bindings.iter().zip(&layout.bindings).enumerate() {
-        if *ty != Some(b.descriptor_type()) {
+        if ty.is_some_and(|t| t != b.descriptor_type()) {
             errors.push(format!(
                 "binding {i} is declared {:?}; the shader has {ty:?}",
                 b.descriptor_type()

@@ -9,8 +9,8 @@ pub mod prefilter;
 pub mod sh;
 pub mod sh_pass;
 pub mod shadow;
-pub mod skybox;
 pub mod sky;
+pub mod skybox;
 
 use crate::error::Result;
 use crate::gpu::Context;

@@ -313,4 +313,3 @@ impl Frame {
         (hdr, Some(ldr))
     }
 }
-

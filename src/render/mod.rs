@@ -85,8 +85,9 @@ pub fn render_scene(
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
     let (w, h) = opts.view.size(screen, skin.resolution);
     let frame = Frame::new(ctx, scene, skin)?;
-    let readback =
-        |name: &str, bytes_per_texel: u64| Readback::new(ctx, name, w as u64 * h as u64 * bytes_per_texel);
+    let readback = |name: &str, bytes_per_texel: u64| {
+        Readback::new(ctx, name, w as u64 * h as u64 * bytes_per_texel)
+    };
     let uv = opts.view.uv_space();
     let ldr_readback = if uv {
         None

@@ -1,7 +1,7 @@
 //! Writing rendered images: PNG (8-bit sRGB) or EXR (linear float), by extension.
 
-use crate::error::{Error, Result};
 use super::RenderOutput;
+use crate::error::{Error, Result};
 use std::path::Path;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -4,8 +4,8 @@
 
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::gpu::{Context, ImageDesc, Pipeline};
 use crate::frame::MeshBuffers;
+use crate::gpu::{Context, ImageDesc, Pipeline};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use std::sync::Arc;
 

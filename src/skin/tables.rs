@@ -4,8 +4,8 @@
 
 use super::specular;
 use crate::error::Result;
-use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
 use crate::frame::FrameInputs;
+use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
 use crate::graph::upload::{upload_buffer, upload_texture};
 use crate::graph::{Access, SimplePass};
 use crate::scene::file::SpecularRegion;
