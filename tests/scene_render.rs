@@ -7,19 +7,9 @@ mod common;
 use dermis::render::{render_scene, RenderOptions, RenderOutput};
 use dermis::scene::file::{load_scene, SceneFile};
 use dermis::scene::Scene;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const SIZE: u32 = 128;
-
-fn assets() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: {} is absent", dir.display());
-        None
-    }
-}
 
 /// Renders `file` under a uniform grey environment, so that every pixel that
 /// differs from the background belongs to the mesh.
@@ -106,7 +96,6 @@ fn builtin_head_renders_in_the_middle_of_the_frame() {
 
 #[test]
 fn lee_perry_smith_scan_renders() {
-    let Some(_) = assets() else { return };
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes/lee-perry-smith.toml");
     let out = render(load_scene(&path).unwrap());
     assert_sane(&coverage(&out), "Lee Perry-Smith");
@@ -260,7 +249,6 @@ fn texture_space_diffusion_leaves_no_seam_lines() {
     assert_no_seams("built-in head", seam_gradients(SceneFile::default(), 350.0));
     // The scan's atlas is one cylindrical chart (seam at the back) plus small
     // charts for the eyes and mouth: few of its seams face the camera.
-    let Some(_) = assets() else { return };
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes/lee-perry-smith.toml");
     assert_no_seams(
         "Lee Perry-Smith",
@@ -349,9 +337,8 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
 fn raster_and_raytraced_occlusion_agree_on_the_scan() {
     use dermis::light::occlusion::{raytrace, RayOptions};
     use dermis::light::occlusion_raster::{raster_vertices, RasterOptions};
-    let Some(dir) = assets() else { return };
     let mesh = dermis::scene::gltf::load_mesh(
-        &dir.join("head/lee-perry-smith/LeePerrySmith.glb"),
+        &dermis::assets::scan().join("LeePerrySmith.glb"),
         Some(50.3),
     )
     .unwrap();

@@ -6,7 +6,6 @@ mod common;
 use dermis::light::envmap::{self, EnvMap};
 use dermis::light::{sh, sh_pass, sky};
 use glam::Vec3;
-use std::path::Path;
 
 fn compare(name: &str, env: &EnvMap, rotation: f32, intensity: f32) {
     let want = sh::rotate_y(&sh::project(env), rotation).map(|c| c * intensity);
@@ -33,20 +32,8 @@ fn gpu_projection_matches_the_cpu_reference() {
     compare("sky rotated 37.5°, intensity 2", &sky_map, 37.5, 2.0);
     let uniform = EnvMap::uniform(Vec3::new(0.25, 0.5, 1.0), 256, 128);
     compare("uniform", &uniform, 0.0, 1.0);
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/env");
-    if !dir.is_dir() {
-        println!("skipped the CC0 maps: {} is absent", dir.display());
-        return;
-    }
-    for name in [
-        "royal_esplanade_1k.hdr",
-        "venice_sunset_1k.hdr",
-        "pedestrian_overpass_1k.hdr",
-        "quarry_01_1k.hdr",
-        "studio.exr",
-        "sunset.exr",
-    ] {
-        let (env, _) = envmap::load(&dir.join(name)).unwrap();
+    for name in dermis::assets::ENV_MAPS {
+        let (env, _) = envmap::load(&dermis::assets::path(&format!("env/{name}"))).unwrap();
         compare(name, &env, -120.0, 1.0);
     }
 }

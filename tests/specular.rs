@@ -429,11 +429,7 @@ fn prefilter_errors(dir: &std::path::Path, name: &str) -> Vec<f32> {
 
 #[test]
 fn prefiltered_environment_matches_brute_force_integration() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/env");
-    if !dir.is_dir() {
-        println!("skipped the CC0 maps: {} is absent", dir.display());
-        return;
-    }
+    let dir = dermis::assets::path("env");
     // A low sun: importance sampling with filtered samples holds it to a few %.
     let e = prefilter_errors(&dir, "venice_sunset_1k.hdr");
     assert!(e[e.len() / 2] < 0.01 && e[e.len() - 1] < 0.05, "{e:?}");

@@ -191,21 +191,8 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    fn assets() -> Option<PathBuf> {
-        let dir = std::env::var_os("DERMIS_ASSETS")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| {
-                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
-            });
-        if dir.join("head/lee-perry-smith").is_dir() {
-            Some(dir.join("head/lee-perry-smith"))
-        } else {
-            println!(
-                "skipping: test assets not found at {} (set DERMIS_ASSETS)",
-                dir.display()
-            );
-            None
-        }
+    fn assets() -> PathBuf {
+        crate::assets::scan()
     }
 
     /// A fresh directory under the system temp dir, unique per test.
@@ -235,7 +222,7 @@ mod tests {
 
     #[test]
     fn lee_perry_smith_maps_load() {
-        let Some(dir) = assets() else { return };
+        let dir = assets();
         for (name, enc) in [
             ("Map-COL.jpg", Encoding::Srgb),
             ("Map-SPEC.jpg", Encoding::Linear),
@@ -347,15 +334,13 @@ mod tests {
         let mut bad_crc = png.clone();
         bad_crc[20] ^= 0x40;
         cases.push(("bad-crc.png", bad_crc));
-        if let Some(assets) = assets() {
-            let jpg = std::fs::read(assets.join("Map-COL.jpg")).unwrap();
-            cases.push(("cut-header.jpg", jpg[..100].to_vec()));
-            cases.push(("cut-middle.jpg", jpg[..jpg.len() / 2].to_vec()));
-            cases.push(("cut-end.jpg", jpg[..jpg.len() - 2].to_vec()));
-            let mut garbage = jpg[..2].to_vec();
-            garbage.extend_from_slice(&[0x12; 500]);
-            cases.push(("garbage.jpg", garbage));
-        }
+        let jpg = std::fs::read(assets().join("Map-COL.jpg")).unwrap();
+        cases.push(("cut-header.jpg", jpg[..100].to_vec()));
+        cases.push(("cut-middle.jpg", jpg[..jpg.len() / 2].to_vec()));
+        cases.push(("cut-end.jpg", jpg[..jpg.len() - 2].to_vec()));
+        let mut garbage = jpg[..2].to_vec();
+        garbage.extend_from_slice(&[0x12; 500]);
+        cases.push(("garbage.jpg", garbage));
         for (name, bytes) in cases {
             let path = dir.join(name);
             std::fs::write(&path, &bytes).unwrap();
@@ -370,7 +355,7 @@ mod tests {
 
     #[test]
     fn fuzzed_jpeg_never_panics() {
-        let Some(assets) = assets() else { return };
+        let assets = assets();
         let jpg = std::fs::read(assets.join("Map-COL.jpg")).unwrap();
         let png = png_bytes(image::DynamicImage::new_rgb8(32, 32));
         let mut rng = 0x2545_F491_4F6C_DD1Du64;

@@ -218,19 +218,8 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    fn lee_perry_smith() -> Option<PathBuf> {
-        let dir = std::env::var_os("DERMIS_ASSETS")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| {
-                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
-            });
-        let glb = dir.join("head/lee-perry-smith/LeePerrySmith.glb");
-        if glb.is_file() {
-            Some(glb)
-        } else {
-            println!("skipping: {} not found (set DERMIS_ASSETS)", glb.display());
-            None
-        }
+    fn lee_perry_smith() -> PathBuf {
+        crate::assets::scan().join("LeePerrySmith.glb")
     }
 
     fn temp_dir(name: &str) -> PathBuf {
@@ -451,7 +440,7 @@ mod tests {
 
     #[test]
     fn lee_perry_smith_head() {
-        let Some(glb) = lee_perry_smith() else { return };
+        let glb = lee_perry_smith();
         let start = std::time::Instant::now();
         let mesh = load_mesh(&glb, Some(50.3)).unwrap();
         println!("loaded {} in {:?}", glb.display(), start.elapsed());
@@ -499,7 +488,7 @@ mod tests {
 
     #[test]
     fn lee_perry_smith_as_gltf_with_external_bin() {
-        let Some(glb) = lee_perry_smith() else { return };
+        let glb = lee_perry_smith();
         let bytes = std::fs::read(&glb).unwrap();
         // Split the GLB into its JSON and BIN chunks (glTF 2.0 §4.4).
         let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
@@ -969,11 +958,9 @@ mod tests {
         for cut in [4, 12, 20, 40, good.len() / 2, good.len() - 1] {
             cases.push((format!("cut-{cut}.glb"), good[..cut].to_vec()));
         }
-        if let Some(lps) = lee_perry_smith() {
-            let bytes = std::fs::read(lps).unwrap();
-            for cut in [11, 100, 1000, 1935, 5000, bytes.len() / 2, bytes.len() - 4] {
-                cases.push((format!("lps-cut-{cut}.glb"), bytes[..cut].to_vec()));
-            }
+        let bytes = std::fs::read(lee_perry_smith()).unwrap();
+        for cut in [11, 100, 1000, 1935, 5000, bytes.len() / 2, bytes.len() - 4] {
+            cases.push((format!("lps-cut-{cut}.glb"), bytes[..cut].to_vec()));
         }
         for (name, bytes) in cases {
             let path = dir.join(&name);
@@ -993,7 +980,7 @@ mod tests {
 
     #[test]
     fn fuzzed_glb_never_panics() {
-        let Some(lps) = lee_perry_smith() else { return };
+        let lps = lee_perry_smith();
         let bytes = std::fs::read(lps).unwrap();
         let json_end =
             20 + u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
