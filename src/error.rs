@@ -38,7 +38,7 @@ pub enum Error {
     #[error(transparent)]
     Scene(#[from] crate::scene::file::SceneError),
     #[error(transparent)]
-    Env(#[from] crate::light::envmap::EnvError),
+    Env(#[from] crate::scene::env::EnvError),
     #[error("{path}: {source}")]
     Io {
         path: String,

@@ -3,13 +3,13 @@
 //! row) and `sh_reduce` (sum, rotate, scale). `light::sh::project` is the CPU
 //! reference it is tested against.
 
-use super::envmap::EnvMap;
 use super::sh::{self, Sh9};
 use crate::error::{Error, Result};
 use crate::gpu::{Binding, Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, BufferHandle, Descriptor, Executor, Graph, Imported};
 use crate::profile::FrameReport;
+use crate::scene::env::EnvMap;
 use ash::vk;
 use glam::{Mat3, Vec3};
 use std::sync::Arc;

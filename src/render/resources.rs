@@ -5,7 +5,7 @@ use crate::error::Result;
 use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
 use crate::graph::upload::{full_mip_count, upload_buffer, upload_texture};
 use crate::graph::Access;
-use crate::light::envmap::EnvMap;
+use crate::scene::env::EnvMap;
 use crate::scene::mesh::Mesh;
 use crate::scene::texture::{Encoding, Texture};
 use ash::vk;
