@@ -39,8 +39,6 @@ pub enum Error {
     /// environment map), as its own typed error; those layers convert into it.
     #[error(transparent)]
     BadInput(Box<dyn std::error::Error + Send + Sync>),
-    #[error(transparent)]
-    Env(#[from] crate::light::envmap::EnvError),
     #[error("{path}: {source}")]
     Io {
         path: String,
@@ -55,8 +53,7 @@ impl Error {
             Error::Input(_)
             | Error::Io { .. }
             | Error::DeviceNotFound { .. }
-            | Error::BadInput(_)
-            | Error::Env(_) => 2,
+            | Error::BadInput(_) => 2,
             _ => 1,
         }
     }

@@ -220,8 +220,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
             timings,
         } => {
             let (w, h) = dermis::scene::PROCEDURAL_ENV_SIZE;
-            let (map, _) =
-                dermis::light::envmap::resolve(&dermis::light::envmap::parse_source(&env)?, w, h)?;
+            let source: dermis::scene::env::EnvSource = env.parse()?;
+            let (map, _) = dermis::scene::env::resolve(&source, w, h)?;
             let ctx = Context::new(&context)?;
             let (coeffs, report) = dermis::light::sh_pass::project(&ctx, &map, rotate, 1.0)?;
             let names = [

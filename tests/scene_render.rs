@@ -14,7 +14,7 @@ const SIZE: u32 = 128;
 /// Renders `file` under a uniform grey environment, so that every pixel that
 /// differs from the background belongs to the mesh.
 fn render(mut file: SceneFile) -> RenderOutput {
-    file.environment.source = "uniform:0.5,0.5,0.5".into();
+    file.environment.source = "uniform:0.5,0.5,0.5".parse().unwrap();
     file.render.width = SIZE;
     file.render.height = SIZE;
     file.render.exposure = Some(0.0);
@@ -261,7 +261,7 @@ fn texture_space_diffusion_leaves_no_seam_lines() {
 fn region_irradiance(occlusion: dermis::scene::file::Occlusion) -> [f32; 10] {
     use dermis::render::View;
     let mut file = SceneFile::default();
-    file.environment.source = "uniform:1,0,0".into();
+    file.environment.source = "uniform:1,0,0".parse().unwrap();
     file.skin.occlusion = occlusion;
     file.render.irradiance_resolution = 512;
     file.render.width = 64;
@@ -370,7 +370,7 @@ fn scattering_bleeds_red_into_the_shadow_edge() {
     use dermis::render::View;
     use dermis::scene::file::{Light, LightKind, Occlusion};
     let mut file = SceneFile::default();
-    file.environment.source = "uniform:0,0,0".into();
+    file.environment.source = "uniform:0,0,0".parse().unwrap();
     file.skin.occlusion = Occlusion::Off;
     file.lights = vec![Light {
         kind: LightKind::Directional,

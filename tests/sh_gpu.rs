@@ -3,8 +3,8 @@
 
 mod common;
 
-use dermis::light::envmap::{self, EnvMap};
-use dermis::light::{sh, sh_pass, sky};
+use dermis::light::{sh, sh_pass};
+use dermis::scene::env::{self as envmap, sky, EnvMap};
 use glam::Vec3;
 
 fn compare(name: &str, env: &EnvMap, rotation: f32, intensity: f32) {

@@ -8,10 +8,10 @@
 
 mod common;
 
-use dermis::light::envmap::{self, EnvMap};
 use dermis::light::prefilter;
 use dermis::render::{render_scene, RenderOptions, View};
 use dermis::scene::camera::Camera;
+use dermis::scene::env::{self as envmap, EnvMap};
 use dermis::scene::file::{Occlusion, SceneFile};
 use dermis::scene::mesh::Mesh;
 use dermis::scene::texture::{Encoding, Texture};

@@ -1,4 +1,4 @@
-// Equirectangular lookup, the convention of light/envmap.rs: +Y up,
+// Equirectangular lookup, the convention of scene/env/map.rs: +Y up,
 // dir = (sinθ sinφ, cosθ, −sinθ cosφ), u = φ/2π + 1/2, v = θ/π.
 const float PI = 3.14159265358979;
 

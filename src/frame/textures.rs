@@ -3,7 +3,7 @@
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc};
 use crate::graph::upload::{full_mip_count, upload_texture};
-use crate::light::envmap::EnvMap;
+use crate::scene::env::EnvMap;
 use crate::scene::texture::{Encoding, Texture};
 use ash::vk;
 use std::sync::Arc;

@@ -1,15 +1,13 @@
-//! Environment lighting: environment maps and the built-in sky, spherical
-//! harmonics (Ramamoorthi & Hanrahan 2001; the paper's section III).
+//! Environment lighting: spherical harmonics (Ramamoorthi & Hanrahan 2001; the
+//! paper's section III). Environment maps and the sky are in `scene::env`.
 
 pub mod direct;
-pub mod envmap;
 pub mod occlusion;
 pub mod occlusion_raster;
 pub mod prefilter;
 pub mod sh;
 pub mod sh_pass;
 pub mod shadow;
-pub mod sky;
 pub mod skybox;
 
 use crate::error::Result;

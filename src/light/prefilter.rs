@@ -12,7 +12,7 @@
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc, Pipeline, Sampler};
 use crate::graph::{Access, Graph, ImageHandle, Imported};
-use crate::light::envmap::EnvMap;
+use crate::scene::env::EnvMap;
 use crate::skin::specular::ks_brdf;
 use ash::vk;
 use glam::Vec3;
@@ -77,7 +77,7 @@ impl PrefilterPass {
 /// The direction of texel (x, y) of one level (y within the level), as the shader
 /// computes it.
 pub fn texel_direction(x: u32, y: u32) -> Vec3 {
-    crate::light::envmap::direction(
+    crate::scene::env::direction(
         (x as f32 + 0.5) / WIDTH as f32,
         (y as f32 + 0.5) / HEIGHT as f32,
     )
@@ -94,7 +94,7 @@ pub fn level_m(k: u32) -> f32 {
 pub fn reference(env: &EnvMap, r: Vec3, m: f32) -> Vec3 {
     let (mut acc, mut total) = (Vec3::ZERO, 0.0f64);
     for y in 0..env.height {
-        let d_omega = crate::light::envmap::texel_solid_angle(y, env.width, env.height);
+        let d_omega = crate::scene::env::texel_solid_angle(y, env.width, env.height);
         for x in 0..env.width {
             let l = env.texel_direction(x, y);
             let w = ks_brdf(r, l, r, m, 1.0) * d_omega;

@@ -20,7 +20,7 @@
 //! # Projection
 //! [`project`] is the CPU reference: `L_i = Σ_texels L(ω) · Y_i(ω) · dω` over
 //! texel centres with exact per-row solid angles
-//! ([`crate::light::envmap::texel_solid_angle`]), accumulated in f64 in a fixed
+//! ([`crate::scene::env::texel_solid_angle`]), accumulated in f64 in a fixed
 //! order: rows top to bottom, texels left to right, each texel adding its nine
 //! RGB terms.
 //!
@@ -42,7 +42,7 @@
 
 use glam::{Mat3, Vec3};
 
-use crate::light::envmap::{texel_solid_angle_f64, EnvMap};
+use crate::scene::env::{texel_solid_angle_f64, EnvMap};
 
 /// Nine RGB coefficients, order `L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22`.
 pub type Sh9 = [Vec3; 9];
@@ -278,7 +278,7 @@ pub fn brute_force_irradiance_many(env: &EnvMap, normals: &[Vec3]) -> Vec<Vec3> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::envmap::{load, texel_solid_angle};
+    use crate::scene::env::{load, texel_solid_angle};
     use std::f64::consts::PI;
     use std::path::PathBuf;
 

@@ -3,7 +3,6 @@
 //! row) and `sh_reduce` (sum, rotate, scale). `light::sh::project` is the CPU
 //! reference it is tested against.
 
-use super::envmap::EnvMap;
 use super::sh::{self, Sh9};
 use crate::error::Result;
 use crate::frame::upload_env;
@@ -11,6 +10,7 @@ use crate::gpu::{Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
 use crate::graph::upload::{upload_buffer, Readback};
 use crate::graph::{Access, BufferHandle, Executor, Graph, Imported};
 use crate::profile::FrameReport;
+use crate::scene::env::EnvMap;
 use ash::vk;
 use glam::{Mat3, Vec3};
 use std::sync::Arc;

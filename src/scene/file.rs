@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::{Deserialize, Deserializer};
 
+use super::env::{EnvSource, SkyParams};
+
 /// Everything that can go wrong reading scene input (scene file, mesh, textures).
 /// Each message is a single line that starts with the offending file.
 #[derive(Debug, thiserror::Error)]
@@ -115,9 +117,11 @@ pub struct Textures {
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Environment {
-    /// `sky`, `sky:elevation=..,azimuth=..,turbidity=..`, `uniform:R,G,B`, or a
-    /// file path (resolved against the scene file's directory on load).
-    pub source: String,
+    /// `sky`, `sky:elevation=..,azimuth=..,turbidity=..`, `uniform:R,G,B`,
+    /// `cube:...` or a file path (resolved against the scene file's directory on
+    /// load), parsed when the file is read.
+    #[serde(deserialize_with = "env_source")]
+    pub source: EnvSource,
     /// Rotation about +Y, degrees.
     pub rotation_deg: f32,
     /// Radiance multiplier.
@@ -127,22 +131,24 @@ pub struct Environment {
 impl Default for Environment {
     fn default() -> Environment {
         Environment {
-            source: "sky".into(),
+            source: EnvSource::Sky(SkyParams::default()),
             rotation_deg: 0.0,
             intensity: 1.0,
         }
     }
 }
 
-impl Environment {
-    /// True when `source` names a file rather than a built-in (`sky...`, `uniform:...`).
-    pub fn source_is_path(&self) -> bool {
-        let s = self.source.as_str();
-        !(s == "sky"
-            || s.starts_with("sky:")
-            || s.starts_with("uniform:")
-            || s.starts_with("cube:"))
+/// The message for an empty `environment.source` (scene file or `--env`).
+pub(crate) const EMPTY_ENV_SOURCE: &str =
+    "environment.source is empty: use \"sky\", \"uniform:R,G,B\" or a file path";
+
+/// `environment.source`: parsed once, here, with `EnvSource`'s `FromStr`.
+fn env_source<'de, D: Deserializer<'de>>(d: D) -> Result<EnvSource, D::Error> {
+    let s = String::deserialize(d)?;
+    if s.trim().is_empty() {
+        return Err(serde::de::Error::custom(EMPTY_ENV_SOURCE));
     }
+    s.parse().map_err(serde::de::Error::custom)
 }
 
 /// Camera: `position`/`target`/`up` (world mm) or an `orbit` around the mesh centre.
@@ -469,12 +475,10 @@ impl SceneFile {
         fix(&mut self.textures.specular);
         fix(&mut self.textures.roughness);
         fix(&mut self.textures.regions);
-        let join = |p: &str| base.join(p.trim()).to_string_lossy().into_owned();
-        if let Some(faces) = self.environment.source.strip_prefix("cube:") {
-            let faces: Vec<String> = faces.split(',').map(join).collect();
-            self.environment.source = format!("cube:{}", faces.join(","));
-        } else if self.environment.source_is_path() {
-            self.environment.source = join(&self.environment.source);
+        match &mut self.environment.source {
+            EnvSource::File(path) => *path = base.join(&*path),
+            EnvSource::Cube(faces) => faces.iter_mut().for_each(|p| *p = base.join(&*p)),
+            EnvSource::Uniform(_) | EnvSource::Sky(_) => {}
         }
     }
 
@@ -550,11 +554,6 @@ fn nonzero3(key: &str, v: [f32; 3]) -> Result<Vec3, String> {
 
 impl Environment {
     fn validate(&self) -> Result<(), String> {
-        if self.source.trim().is_empty() {
-            return Err(
-                "environment.source is empty: use \"sky\", \"uniform:R,G,B\" or a file path".into(),
-            );
-        }
         finite("environment.rotation_deg", self.rotation_deg)?;
         non_negative("environment.intensity", self.intensity)
     }
@@ -816,7 +815,10 @@ mod tests {
         assert_eq!(scene, SceneFile::default());
         assert!(SceneFile::default().validate().is_ok());
         assert_eq!(scene.mesh, None);
-        assert_eq!(scene.environment.source, "sky");
+        assert_eq!(
+            scene.environment.source,
+            EnvSource::Sky(SkyParams::default())
+        );
         assert_eq!(scene.skin.mix, 0.5);
         assert_eq!(scene.skin.profile, None);
         assert_eq!(scene.skin.regions, None);
@@ -879,7 +881,10 @@ gamma = 2.2
         );
         assert_eq!(s.textures.normal, Some(PathBuf::from("/abs/normal.png")));
         assert_eq!(s.textures.specular, None);
-        assert_eq!(s.environment.source, "/scenes/env/studio.exr");
+        assert_eq!(
+            s.environment.source,
+            EnvSource::File(PathBuf::from("/scenes/env/studio.exr"))
+        );
         assert_eq!(s.environment.intensity, 2.5);
         assert_eq!(s.camera.fov_deg, 25.0);
         assert_eq!(s.lights.len(), 2);
@@ -912,12 +917,46 @@ gamma = 2.2
             "uniform:1,1,1",
         ] {
             let s = parse(&format!("[environment]\nsource = \"{src}\"")).unwrap();
-            assert_eq!(s.environment.source, src);
+            assert_eq!(s.environment.source, src.parse::<EnvSource>().unwrap());
         }
         let s = parse("[environment]\nsource = \"skylight.hdr\"").unwrap();
-        assert_eq!(s.environment.source, "/scenes/skylight.hdr");
+        assert_eq!(
+            s.environment.source,
+            EnvSource::File(PathBuf::from("/scenes/skylight.hdr"))
+        );
         let s = parse_scene("mesh = \"a.glb\"", Path::new("scene.toml")).unwrap();
         assert_eq!(s.mesh, Some(PathBuf::from("./a.glb")));
+        let s = parse(
+            "[environment]\nsource = \"cube:f/px.hdr, nx.hdr,py.hdr,ny.hdr,pz.hdr,/abs/nz.hdr\"",
+        )
+        .unwrap();
+        let EnvSource::Cube(faces) = &s.environment.source else {
+            panic!("{:?}", s.environment.source)
+        };
+        assert_eq!(faces[0], PathBuf::from("/scenes/f/px.hdr"));
+        assert_eq!(faces[1], PathBuf::from("/scenes/nx.hdr"));
+        assert_eq!(faces[5], PathBuf::from("/abs/nz.hdr"));
+    }
+
+    #[test]
+    fn bad_environment_sources_name_the_file_and_line() {
+        for (src, needle) in [
+            (
+                "uniform:1,nan,1",
+                "environment source 'uniform:1,nan,1': radiance NaN must be finite and >= 0",
+            ),
+            ("uniform", "expected uniform:R,G,B or uniform:V"),
+            ("sky:foo=1", "unknown key 'foo'"),
+            ("sky:elevation=95", "sky: elevation 95° is outside [0, 90]"),
+            ("cube:a.hdr,b.hdr", "six face files"),
+            (" ", "environment.source is empty"),
+        ] {
+            let msg = err(&format!("[environment]\nsource = \"{src}\""));
+            assert!(
+                msg.contains("line 2,") && msg.contains(needle),
+                "{src}: {msg}"
+            );
+        }
     }
 
     #[test]

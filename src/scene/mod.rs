@@ -2,6 +2,7 @@
 //! the environment, camera and lights, from a TOML scene file plus CLI overrides.
 
 pub mod camera;
+pub mod env;
 pub mod file;
 pub mod gltf;
 pub mod head;
@@ -9,8 +10,8 @@ pub mod mesh;
 pub mod texture;
 
 use crate::error::Result;
-use crate::light::envmap::{self, EnvMap};
 use camera::Camera;
+use env::EnvMap;
 use file::{LightKind, Occlusion, SceneFile};
 use glam::Vec3;
 use mesh::Mesh;
@@ -26,6 +27,7 @@ pub const PROCEDURAL_ENV_SIZE: (u32, u32) = (1024, 512);
 pub struct Overrides {
     pub mesh: Option<PathBuf>,
     pub mm_per_unit: Option<f32>,
+    /// `--env`: a source string, parsed by [`Overrides::apply`].
     pub env: Option<String>,
     pub env_rotate_deg: Option<f32>,
     pub exposure: Option<f32>,
@@ -43,7 +45,14 @@ impl Overrides {
         }
         file.mm_per_unit = self.mm_per_unit.or(file.mm_per_unit);
         if let Some(env) = &self.env {
-            file.environment.source = env.clone();
+            // Parsed like the scene file's `environment.source`.
+            if env.trim().is_empty() {
+                return Err(crate::Error::Input(format!(
+                    "command line: {}",
+                    file::EMPTY_ENV_SOURCE
+                )));
+            }
+            file.environment.source = env.parse()?;
         }
         file.environment.rotation_deg =
             self.env_rotate_deg.unwrap_or(file.environment.rotation_deg);
@@ -159,9 +168,8 @@ impl Scene {
         let specular = load(&t.specular, Encoding::Linear, texture::DEFAULT_SPECULAR)?;
         // m = 0.3 (GPU Gems 3 §14.3) encoded as grey/255.
         let roughness = load(&t.roughness, Encoding::Linear, [77, 77, 77, 255])?;
-        let source = envmap::parse_source(&file.environment.source)?;
         let (w, h) = PROCEDURAL_ENV_SIZE;
-        let (env, report) = envmap::resolve(&source, w, h)?;
+        let (env, report) = env::resolve(&file.environment.source, w, h)?;
         if report.total() > 0 {
             log::warn!(
                 "{}: replaced {} NaN, {} infinite and {} negative texel values",

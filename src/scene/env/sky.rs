@@ -40,7 +40,7 @@
 
 use glam::Vec3;
 
-use crate::light::envmap::{direction, direction_to_uv, texel_solid_angle_f64, EnvMap};
+use super::map::{direction, direction_to_uv, texel_solid_angle_f64, EnvMap};
 
 /// Apparent angular diameter of the sun (degrees), mean value.
 pub const SUN_ANGULAR_DIAMETER_DEG: f32 = 0.53;
