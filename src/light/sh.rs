@@ -447,18 +447,8 @@ mod tests {
         }
     }
 
-    fn assets() -> Option<PathBuf> {
-        let dir = std::env::var("DERMIS_ASSETS")
-            .map(PathBuf::from)
-            .unwrap_or_else(|_| {
-                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
-            });
-        if dir.join("env").is_dir() {
-            Some(dir)
-        } else {
-            println!("SKIP: test assets not found at {}", dir.display());
-            None
-        }
+    fn assets() -> PathBuf {
+        crate::assets::dir()
     }
 
     const MAPS: [&str; 6] = [
@@ -501,7 +491,7 @@ mod tests {
 
     #[test]
     fn rh_irradiance_vs_brute_force_on_real_maps() {
-        let Some(dir) = assets() else { return };
+        let dir = assets();
         let normals = fibonacci(256);
         let (bound_mean, bound_max) = point_light_bound();
         println!(
@@ -565,12 +555,9 @@ mod tests {
     /// force, must equal R&H's closed form (Funk–Hecke).
     #[test]
     fn rh_irradiance_equals_irradiance_of_reconstruction() {
-        let env = match assets() {
-            Some(dir) => load(&dir.join("env/pedestrian_overpass_1k.hdr")).unwrap().0,
-            None => EnvMap::from_fn(512, 256, |d| {
-                Vec3::new(1.0 + d.x, 2.0 + d.y * d.z, 1.5 - d.z)
-            }),
-        };
+        let env = load(&assets().join("env/pedestrian_overpass_1k.hdr"))
+            .unwrap()
+            .0;
         let l = project(&env);
         let recon = EnvMap::from_fn(512, 256, |d| dot(&l, &basis(d)));
         let normals = fibonacci(64);
@@ -595,10 +582,9 @@ mod tests {
 
     #[test]
     fn rotate_y_matches_rotated_map() {
-        let env = match assets() {
-            Some(dir) => load(&dir.join("env/royal_esplanade_1k.hdr")).unwrap().0,
-            None => lobe(Vec3::new(0.6, 0.2, -0.77).normalize(), 1024, 512),
-        };
+        let env = load(&assets().join("env/royal_esplanade_1k.hdr"))
+            .unwrap()
+            .0;
         let l = project(&env);
         for deg in [37.3f32, -101.7, 200.05] {
             let a = rotate_y(&l, deg);

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use texture::{Encoding, Texture};
 
 /// Size of procedural environments (`uniform:`, `sky`): 1024×512, the size of the
-/// CC0 maps in shared/assets/env.
+/// CC0 maps in assets/env.
 pub const PROCEDURAL_ENV_SIZE: (u32, u32) = (1024, 512);
 
 /// CLI flags that override the scene file's common fields.

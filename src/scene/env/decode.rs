@@ -420,18 +420,8 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    fn assets() -> Option<PathBuf> {
-        let dir = std::env::var("DERMIS_ASSETS")
-            .map(PathBuf::from)
-            .unwrap_or_else(|_| {
-                PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/assets"))
-            });
-        if dir.join("env").is_dir() {
-            Some(dir)
-        } else {
-            println!("SKIP: test assets not found at {}", dir.display());
-            None
-        }
+    fn assets() -> PathBuf {
+        crate::assets::dir()
     }
 
     fn temp_dir(name: &str) -> PathBuf {
@@ -467,7 +457,7 @@ mod tests {
 
     #[test]
     fn load_real_maps() {
-        let Some(dir) = assets() else { return };
+        let dir = assets();
         for name in [
             "studio.exr",
             "sunset.exr",
@@ -666,10 +656,9 @@ mod tests {
             .encode(&px, 32, 16)
             .unwrap();
         v.push(small_hdr);
-        if let Some(a) = assets() {
-            v.push(a.join("env/studio.exr"));
-            v.push(a.join("env/royal_esplanade_1k.hdr"));
-        }
+        let a = assets();
+        v.push(a.join("env/studio.exr"));
+        v.push(a.join("env/royal_esplanade_1k.hdr"));
         v
     }
 
@@ -748,7 +737,7 @@ mod tests {
     fn dwa_leader_guard() {
         // Regression: one flipped bit in the first DWA chunk leader of
         // studio.exr made the exr crate allocate 34 GB and abort the process.
-        let Some(a) = assets() else { return };
+        let a = assets();
         let mut b = std::fs::read(a.join("env/studio.exr")).unwrap();
         b[0x385] ^= 0x04;
         let p = temp_dir("dwa").join("dwa_flip.exr");
