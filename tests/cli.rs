@@ -340,3 +340,8 @@ fn precompute_fills_the_cache_and_reports_time() {
     let out = dermis(&["precompute", "--occlusion", "sideways"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn zero_frames_is_a_clean_input_error() {
+    assert_bad_input(&["--frames", "0", "--irradiance-res", "256"], "0 frames");
+}

@@ -17,7 +17,7 @@ use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{ShadowPass, ShadowView};
 use crate::light::skybox::SkyboxPass;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
-use crate::scene::file::Occlusion;
+use crate::scene::file::{Gamma, Occlusion};
 use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::irradiance::IrradiancePass;
@@ -124,6 +124,7 @@ pub(super) struct Frame {
     skin: SkinSettings,
     constant_stretch: Option<f32>,
     exposure: f32,
+    gamma: Gamma,
 }
 
 impl Frame {
@@ -202,6 +203,7 @@ impl Frame {
             skin,
             constant_stretch,
             exposure: scene.exposure(),
+            gamma: scene.file.render.gamma,
         })
     }
 
@@ -309,7 +311,7 @@ impl Frame {
         }
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
         self.tonemap
-            .pass(g, &hdr, &mut ldr, self.exposure_for(view));
+            .pass(g, &hdr, &mut ldr, self.exposure_for(view), self.gamma);
         (hdr, Some(ldr))
     }
 }

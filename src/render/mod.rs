@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, DeviceInfo};
 use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph};
+use crate::post::tonemap::encode8;
 use crate::profile::RunReport;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
@@ -79,6 +80,9 @@ pub fn render_scene(
     scene: &Scene,
     opts: &RenderOptions,
 ) -> Result<RenderOutput> {
+    if opts.frames == 0 {
+        return Err(Error::Input("frames: 0 frames render nothing; give 1 or more".into()));
+    }
     let screen = (scene.file.render.width, scene.file.render.height);
     check_target(&ctx.info, screen.0, screen.1)?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
@@ -103,7 +107,7 @@ pub fn render_scene(
     let mut executor = Executor::new(ctx, 2)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
-    for i in 0..opts.frames.max(1) {
+    for i in 0..opts.frames {
         let mut g = Graph::new();
         let (hdr, ldr) = frame.graph(&mut g, opts.view, screen, i == 0);
         if let (Some(ldr), Some(r)) = (&ldr, &ldr_readback) {
@@ -133,7 +137,7 @@ pub fn render_scene(
     };
     let rgba8 = match (&ldr_readback, &hdr) {
         (Some(b), _) => b.bytes()?.to_vec(),
-        (None, Some(values)) => output::encode_srgb8(values, exposure),
+        (None, Some(values)) => encode8(values, exposure, scene.file.render.gamma),
         (None, None) => Vec::new(),
     };
     let report = RunReport::new(&ctx.info, w, h, reports, executor.pool_bytes());

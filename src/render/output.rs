@@ -50,23 +50,3 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> Result<(
     })
     .map_err(|e| Error::Input(format!("{}: cannot write EXR: {e}", path.display())))
 }
-
-/// Linear RGBA → 8-bit sRGB after × 2^exposure (IEC 61966-2-1), for PNGs of
-/// images read back as floats.
-pub fn encode_srgb8(rgba: &[f32], exposure: f32) -> Vec<u8> {
-    let scale = exposure.exp2();
-    rgba.chunks_exact(4)
-        .flat_map(|p| {
-            let enc = |c: f32| {
-                let c = (c * scale).clamp(0.0, 1.0);
-                let s = if c <= 0.003_130_8 {
-                    12.92 * c
-                } else {
-                    1.055 * c.powf(1.0 / 2.4) - 0.055
-                };
-                (s * 255.0).round() as u8
-            };
-            [enc(p[0]), enc(p[1]), enc(p[2]), 255]
-        })
-        .collect()
-}
