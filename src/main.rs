@@ -201,7 +201,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             let mesh = dermis::scene::load_mesh(&file)?;
             let ctx = Context::new(&context)?;
             let started = std::time::Instant::now();
-            let t = dermis::light::transfer_for(&ctx, &mesh, file.skin.occlusion)?;
+            let t = dermis::light::occlusion::transfer_for(&ctx, &mesh, file.skin.occlusion)?;
             let secs = started.elapsed().as_secs_f64();
             println!(
                 "{} vertices, occlusion {:?}: {:.2} s ({:.1} µs per vertex), cache {}",

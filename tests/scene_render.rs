@@ -335,8 +335,8 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
 
 #[test]
 fn raster_and_raytraced_occlusion_agree_on_the_scan() {
+    use dermis::light::occlusion::raster::{raster_vertices, RasterOptions};
     use dermis::light::occlusion::{raytrace, RayOptions};
-    use dermis::light::occlusion_raster::{raster_vertices, RasterOptions};
     let mesh = dermis::scene::gltf::load_mesh(
         &dermis::assets::scan().join("LeePerrySmith.glb"),
         Some(50.3),

@@ -30,7 +30,8 @@ fn the_pass_encodes_a_ramp_as_the_cpu_reference_does() {
         let got = common::with_gpu(|ctx| {
             let desc = ImageDesc::new(W, 1, dermis::testscene::HALF);
             let src = upload_texture(ctx, "ramp", desc, &common::to_f16_bytes(&ramp)).unwrap();
-            let tonemap = Tonemap::new(ctx, Arc::new(Sampler::clamped(ctx, false).unwrap())).unwrap();
+            let tonemap =
+                Tonemap::new(ctx, Arc::new(Sampler::clamped(ctx, false).unwrap())).unwrap();
             let readback = Readback::new(ctx, "ldr", W as u64 * 4).unwrap();
             let mut g = Graph::new();
             let hdr = g.import_image(

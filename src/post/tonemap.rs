@@ -101,6 +101,9 @@ mod tests {
         assert_eq!(encode(0.25, Gamma::Power(1.0)), 0.25);
         assert!((encode(7.0, Gamma::Srgb) - 1.0).abs() < 1e-6);
         // Exposure +1 EV doubles before encoding.
-        assert_eq!(encode8(&[0.125, 0.0, 1.0, 1.0], 1.0, Gamma::Power(1.0)), [64, 0, 255, 255]);
+        assert_eq!(
+            encode8(&[0.125, 0.0, 1.0, 1.0], 1.0, Gamma::Power(1.0)),
+            [64, 0, 255, 255]
+        );
     }
 }

@@ -154,8 +154,12 @@ impl Frame {
                 ctx,
                 "transfer",
                 bytemuck::cast_slice(
-                    &crate::light::transfer_for(ctx, &scene.mesh, scene.file.skin.occlusion)?
-                        .coeffs,
+                    &crate::light::occlusion::transfer_for(
+                        ctx,
+                        &scene.mesh,
+                        scene.file.skin.occlusion,
+                    )?
+                    .coeffs,
                 ),
                 Access::ShaderBufferRead,
             )?,

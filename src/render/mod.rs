@@ -81,7 +81,9 @@ pub fn render_scene(
     opts: &RenderOptions,
 ) -> Result<RenderOutput> {
     if opts.frames == 0 {
-        return Err(Error::Input("frames: 0 frames render nothing; give 1 or more".into()));
+        return Err(Error::Input(
+            "frames: 0 frames render nothing; give 1 or more".into(),
+        ));
     }
     let screen = (scene.file.render.width, scene.file.render.height);
     check_target(&ctx.info, screen.0, screen.1)?;

@@ -5,7 +5,7 @@
 //! compute pass reduces each vertex's six tiles. `occlusion::raytrace` is the
 //! independent CPU method it is compared with.
 
-use super::occlusion::Transfer;
+use super::transfer::Transfer;
 use crate::error::{Error, Result};
 use crate::frame::{MeshBuffers, Vertex};
 use crate::gpu::{Buffer, Context, GraphicsDesc, ImageDesc, MemoryLocation, Pipeline, Sampler};

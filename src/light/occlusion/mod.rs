@@ -1,0 +1,73 @@
+//! Per-vertex SH visibility transfer: by CPU ray casting or by the paper's cube
+//! maps on the GPU, and its disk cache.
+//!
+//! # What is computed
+//! Yang, Wang & Zuo 2012 eq. 12–13: the diffuse irradiance at a vertex is
+//! `E = ∫_S L(ω) V(ω) max(N·ω, 0) dω = Σ_i L_i T_i` with the transfer vector
+//! ```text
+//! T_i = ∫_S V(ω) · max(N·ω, 0) · y_i(ω) dω ,   i = 0..8
+//! ```
+//! (`y_i` = [`sh::basis`](crate::light::sh::basis), world axes). With `V ≡ 1`,
+//! `T = sh::cosine_transfer(N)` ([`unoccluded`], the `--occlusion off` case).
+//! The paper evaluates `V` by rasterising a cube map at each vertex
+//! ([`raster`]); [`raytrace()`] instead casts rays against a BVH of the mesh's
+//! triangles (any-hit queries).
+//!
+//! # Files
+//! `transfer.rs` ([`Transfer`]), `raytrace.rs` (the CPU estimator), `bvh.rs`
+//! (the [`Bvh`] it queries), `raster.rs` (the GPU method), `cache.rs` (the disk
+//! cache, [`cache_key`]); [`transfer_for`] picks one, cache first.
+
+mod bvh;
+mod cache;
+pub mod raster;
+mod raytrace;
+#[cfg(test)]
+mod testutil;
+mod transfer;
+
+pub use bvh::Bvh;
+pub use cache::{cache_key, default_cache_dir, load_cached, store_cached};
+pub use raytrace::{raytrace, RayOptions};
+pub use transfer::{unoccluded, Transfer};
+
+use std::sync::Arc;
+
+use crate::error::Result;
+use crate::gpu::Context;
+use crate::scene::file::Occlusion;
+use crate::scene::mesh::Mesh;
+use raster::RasterOptions;
+
+/// The per-vertex SH transfer for `mode` (unoccluded for `Off`), from the disk
+/// cache when it holds it (keyed by the mesh, the method and its settings).
+pub fn transfer_for(ctx: &Arc<Context>, mesh: &Mesh, mode: Occlusion) -> Result<Transfer> {
+    let (method, settings) = match mode {
+        Occlusion::Off => return Ok(unoccluded(mesh)),
+        Occlusion::Raytrace => ("raytrace", RayOptions::default().cache_settings()),
+        Occlusion::Raster => ("raster", RasterOptions::default().cache_settings()),
+    };
+    let key = cache_key(mesh, method, &settings);
+    let dir = default_cache_dir();
+    if let Some(t) = load_cached(&dir, &key) {
+        log::info!(
+            "occlusion: cached {method} transfer {key} from {}",
+            dir.display()
+        );
+        return Ok(t);
+    }
+    let started = std::time::Instant::now();
+    let t = match mode {
+        Occlusion::Raster => raster::raster(ctx, mesh, &RasterOptions::default(), true)?,
+        _ => raytrace(mesh, &RayOptions::default(), true),
+    };
+    log::info!(
+        "occlusion: {method} for {} vertices in {:.2} s",
+        mesh.vertex_count(),
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = store_cached(&dir, &key, &t) {
+        log::warn!("occlusion: cannot cache in {}: {e}", dir.display());
+    }
+    Ok(t)
+}
