@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{load_scene, Occlusion, SceneFile};
+use dermis::scene::file::{load_scene, Occlusion, SceneFile, UvOrigin};
 use dermis::scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -94,6 +94,9 @@ enum Command {
         /// Per-vertex occlusion: raster (the paper's cube maps), raytrace, off.
         #[arg(long, value_parser = parse_occlusion)]
         occlusion: Option<Occlusion>,
+        /// The maps' UV origin: top-left (glTF) or bottom-left (OpenGL; flipped on load).
+        #[arg(long, value_parser = str::parse::<UvOrigin>)]
+        uv_origin: Option<UvOrigin>,
         #[arg(long)]
         width: Option<u32>,
         #[arg(long)]
@@ -255,6 +258,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             exposure,
             irradiance_res,
             occlusion,
+            uv_origin,
             width,
             height,
             view,
@@ -275,6 +279,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 exposure,
                 irradiance_resolution: irradiance_res,
                 occlusion,
+                uv_origin,
                 width,
                 height,
             };

@@ -199,6 +199,10 @@ fn bad_scene_input_is_a_clean_error() {
 
     assert_bad_input(&["--env", "uniform:1,nan,1"], "uniform");
     assert_bad_input(&["--irradiance-res", "3000"], "irradiance_resolution");
+    assert_bad_input(
+        &["--uv-origin", "upper-left"],
+        "expected top-left or bottom-left",
+    );
 }
 
 #[test]

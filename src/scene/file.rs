@@ -111,6 +111,33 @@ pub struct Textures {
     pub roughness: Option<PathBuf>,
     /// Face-region ids: red channel = index into `skin.regions` (0..=9).
     pub regions: Option<PathBuf>,
+    /// Which corner of the maps the UV origin is; applies to every map given.
+    pub uv_origin: UvOrigin,
+}
+
+/// The texture corner at UV (0, 0), i.e. the image row that v = 0 samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum UvOrigin {
+    /// glTF 2.0 (UV (0, 0) is "the upper left corner of a texture image"),
+    /// Vulkan, Direct3D: row 0 at v = 0. The renderer's own convention.
+    #[default]
+    TopLeft,
+    /// OpenGL: row 0 at v = 1. The maps are flipped vertically on load and the
+    /// bitangent sign negated (`Scene::load`).
+    BottomLeft,
+}
+
+impl std::str::FromStr for UvOrigin {
+    type Err = String;
+    /// The scene file's spelling: `top-left` or `bottom-left`.
+    fn from_str(s: &str) -> Result<UvOrigin, String> {
+        match s {
+            "top-left" => Ok(UvOrigin::TopLeft),
+            "bottom-left" => Ok(UvOrigin::BottomLeft),
+            _ => Err(format!("{s:?}: expected top-left or bottom-left")),
+        }
+    }
 }
 
 /// Distant lighting.
@@ -946,6 +973,23 @@ gamma = 2.2
     }
 
     #[test]
+    fn uv_origin_defaults_to_top_left() {
+        assert_eq!(parse("").unwrap().textures.uv_origin, UvOrigin::TopLeft);
+        for (text, origin) in [
+            ("top-left", UvOrigin::TopLeft),
+            ("bottom-left", UvOrigin::BottomLeft),
+        ] {
+            let s = parse(&format!("[textures]\nuv_origin = \"{text}\"")).unwrap();
+            assert_eq!(s.textures.uv_origin, origin);
+            assert_eq!(text.parse::<UvOrigin>(), Ok(origin));
+        }
+        assert!("TopLeft"
+            .parse::<UvOrigin>()
+            .unwrap_err()
+            .contains("top-left or bottom-left"));
+    }
+
+    #[test]
     fn camera_look_at() {
         let s = parse("[camera]\nposition = [0, 0, 500]\n").unwrap();
         let (eye, target, up) = s.camera.eye_target_up(Vec3::new(0.0, 10.0, 0.0));
@@ -981,6 +1025,11 @@ gamma = 2.2
             ("[render]\nwidth = 1.5", 2, "invalid type"),
             ("[skin]\nmix = \"half\"", 2, "invalid type"),
             ("[skin]\nkernel = \"box\"", 2, "unknown variant"),
+            (
+                "[textures]\nuv_origin = \"bottom-right\"",
+                2,
+                "unknown variant `bottom-right`, expected `top-left` or `bottom-left`",
+            ),
             ("[[lights]]\nkind = \"spot\"", 2, "unknown variant"),
             ("[[lights]]\ndirection = [0,0,1]", 1, "missing field `kind`"),
             ("[render]\ngamma = \"s-rgb\"", 2, "srgb"),

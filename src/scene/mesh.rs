@@ -27,6 +27,21 @@ impl Mesh {
         self.indices.len() / 3
     }
 
+    /// Negates every tangent's bitangent sign `w`, for normal maps flipped
+    /// vertically on load (`Texture::flip_vertical`, `UvOrigin::BottomLeft`).
+    ///
+    /// The shader's bitangent `w · n × t` points toward decreasing v, the top of
+    /// the image, where a glTF normal map's green (+Y) points. A map authored
+    /// for a bottom-left origin has +Y toward increasing v_GL = 1 − v, the top
+    /// of its file; flipped, that is the bottom of the image, increasing v. The
+    /// tangent (+u) is unchanged, so only the bitangent turns: w → −w
+    /// (measured on the scan in `scene::uv_origin_tests`).
+    pub fn negate_bitangent_sign(&mut self) {
+        for t in &mut self.tangents {
+            t.w = -t.w;
+        }
+    }
+
     /// Axis-aligned bounds (min, max) in mm; `None` for an empty mesh.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.positions.first()?;

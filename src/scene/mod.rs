@@ -9,10 +9,13 @@ pub mod head;
 pub mod mesh;
 pub mod texture;
 
+#[cfg(test)]
+mod uv_origin_tests;
+
 use crate::error::Result;
 use camera::Camera;
 use env::EnvMap;
-use file::{LightKind, Occlusion, SceneFile};
+use file::{LightKind, Occlusion, SceneFile, UvOrigin};
 use glam::Vec3;
 use mesh::Mesh;
 use std::path::PathBuf;
@@ -33,6 +36,8 @@ pub struct Overrides {
     pub exposure: Option<f32>,
     pub irradiance_resolution: Option<u32>,
     pub occlusion: Option<Occlusion>,
+    /// `--uv-origin`: replaces `textures.uv_origin`.
+    pub uv_origin: Option<UvOrigin>,
     pub width: Option<u32>,
     pub height: Option<u32>,
 }
@@ -61,6 +66,7 @@ impl Overrides {
             .irradiance_resolution
             .unwrap_or(file.render.irradiance_resolution);
         file.skin.occlusion = self.occlusion.unwrap_or(file.skin.occlusion);
+        file.textures.uv_origin = self.uv_origin.unwrap_or(file.textures.uv_origin);
         file.render.width = self.width.unwrap_or(file.render.width);
         file.render.height = self.height.unwrap_or(file.render.height);
         file.validate()
@@ -127,13 +133,21 @@ pub struct Scene {
 impl Scene {
     pub fn load(file: SceneFile) -> Result<Scene> {
         let t = &file.textures;
+        let bottom_left = t.uv_origin == UvOrigin::BottomLeft;
+        // Maps from the file, turned to glTF's top-left origin; stand-ins are uniform.
         let load = |path: &Option<PathBuf>, encoding, default: [u8; 4]| -> Result<Texture> {
             Ok(match path {
-                Some(p) => texture::load_texture(p, encoding)?,
+                Some(p) => {
+                    let mut texture = texture::load_texture(p, encoding)?;
+                    if bottom_left {
+                        texture.flip_vertical();
+                    }
+                    texture
+                }
                 None => Texture::solid(default, encoding),
             })
         };
-        let (mesh, albedo, normal, regions) = match &file.mesh {
+        let (mut mesh, albedo, normal, regions) = match &file.mesh {
             Some(path) => (
                 gltf::load_mesh(path, file.mm_per_unit)?,
                 load(&t.albedo, Encoding::Srgb, texture::DEFAULT_ALBEDO_SRGB)?,
@@ -165,6 +179,10 @@ impl Scene {
                 (head.mesh, albedo, normal, regions)
             }
         };
+        // A flipped normal map's +Y points toward increasing v (Mesh::negate_bitangent_sign).
+        if bottom_left && t.normal.is_some() {
+            mesh.negate_bitangent_sign();
+        }
         let specular = load(&t.specular, Encoding::Linear, texture::DEFAULT_SPECULAR)?;
         // m = 0.3 (GPU Gems 3 §14.3) encoded as grey/255.
         let roughness = load(&t.roughness, Encoding::Linear, [77, 77, 77, 255])?;

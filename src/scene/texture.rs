@@ -52,6 +52,18 @@ impl Texture {
             rgba8: rgba.to_vec(),
         }
     }
+
+    /// Reverses the row order: a map authored with its UV origin at the bottom
+    /// left (OpenGL) becomes one sampled with glTF's top-left origin, since the
+    /// texel for (u, v) moves from row (1 − v)·h to row v·h.
+    pub fn flip_vertical(&mut self) {
+        let row = self.width as usize * 4;
+        let h = self.height as usize;
+        for y in 0..h / 2 {
+            let (top, bottom) = self.rgba8.split_at_mut((h - 1 - y) * row);
+            top[y * row..(y + 1) * row].swap_with_slice(&mut bottom[..row]);
+        }
+    }
 }
 
 /// Loads a PNG or JPEG file (the format is detected from the content) as RGBA8.
@@ -218,6 +230,33 @@ mod tests {
         assert_eq!((t.width, t.height), (1, 1));
         assert_eq!(t.rgba8, vec![1, 2, 3, 4]);
         assert_eq!(t.encoding, Encoding::Linear);
+    }
+
+    #[test]
+    fn flip_vertical_reverses_rows() {
+        // 2 x 3, one distinct byte per texel channel.
+        let rows: Vec<Vec<u8>> = (0..3u8)
+            .map(|y| (0..8).map(|i| y * 8 + i).collect())
+            .collect();
+        let mut t = Texture {
+            width: 2,
+            height: 3,
+            encoding: Encoding::Linear,
+            rgba8: rows.concat(),
+        };
+        t.flip_vertical();
+        assert_eq!(t.rgba8, [&rows[2][..], &rows[1], &rows[0]].concat());
+        t.flip_vertical();
+        assert_eq!(t.rgba8, rows.concat());
+        // Even height: every row moves.
+        let mut t = Texture {
+            width: 1,
+            height: 2,
+            encoding: Encoding::Srgb,
+            rgba8: vec![1, 2, 3, 4, 5, 6, 7, 8],
+        };
+        t.flip_vertical();
+        assert_eq!(t.rgba8, vec![5, 6, 7, 8, 1, 2, 3, 4]);
     }
 
     #[test]
