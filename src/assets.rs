@@ -1,7 +1,7 @@
 //! The repository's own assets (`assets/`, see its README: the Lee Perry-Smith scan,
-//! CC BY 3.0, and CC0 environment maps), located for tests, benches and examples.
-//! One helper for unit and integration tests alike: a missing asset fails the
-//! test that needs it, naming the file; nothing skips.
+//! CC BY 3.0, CC0 environment maps, the default scene), located for the default
+//! scene, tests, benches and examples. One helper for unit and integration tests
+//! alike: a missing asset fails the test that needs it, naming the file.
 
 use std::path::{Path, PathBuf};
 

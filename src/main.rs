@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{load_scene, Occlusion, SceneFile, UvOrigin};
+use dermis::scene::file::{scene_by_name, Occlusion, UvOrigin};
 use dermis::scene::Overrides;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -52,7 +52,8 @@ enum Command {
     },
     /// Compute (and cache) the per-vertex occlusion transfer ahead of rendering.
     Precompute {
-        /// TOML scene file; its mesh and `skin.occlusion` are used.
+        /// Scene file (its mesh and `skin.occlusion` are used), or `builtin`;
+        /// default: assets/default.toml.
         #[arg(long)]
         scene: Option<PathBuf>,
         /// glTF mesh, replacing the scene's.
@@ -64,9 +65,10 @@ enum Command {
         #[arg(long, value_parser = parse_occlusion)]
         occlusion: Option<Occlusion>,
     },
-    /// Render the scene to an image (the built-in head under the sky by default).
+    /// Render a scene to an image (by default the scanned head, assets/default.toml).
     Render {
-        /// TOML scene file (see docs/scene-format.md).
+        /// Scene file (docs/scene-format.md), or `builtin` for the built-in
+        /// procedural head under the sky; default: assets/default.toml.
         #[arg(long)]
         scene: Option<PathBuf>,
         /// Output image: .png (8-bit sRGB) or .exr (linear float).
@@ -190,10 +192,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             mm_per_unit,
             occlusion,
         } => {
-            let file = match &scene {
-                Some(path) => load_scene(path)?,
-                None => SceneFile::default(),
-            };
+            let file = scene_by_name(scene.as_deref())?;
             let file = Overrides {
                 mesh,
                 mm_per_unit,
@@ -267,10 +266,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             report,
             dump_graph,
         } => {
-            let file = match &scene {
-                Some(path) => load_scene(path)?,
-                None => SceneFile::default(),
-            };
+            let file = scene_by_name(scene.as_deref())?;
             let overrides = Overrides {
                 mesh,
                 mm_per_unit,

@@ -446,6 +446,26 @@ pub const MAX_RENDER_SIZE: u32 = 16384;
 // ---------------------------------------------------------------------------
 // Loading
 
+/// What `--scene` names: `builtin` is the built-in procedural head under the sky
+/// ([`SceneFile::default`]); anything else a scene file.
+pub const BUILTIN: &str = "builtin";
+
+/// The scene `dermis render` draws when none is named: `assets/default.toml`, the
+/// scan under a CC0 map, framed as a portrait.
+pub fn default_scene_path() -> PathBuf {
+    crate::assets::dir().join("default.toml")
+}
+
+/// The scene a command line names: `None` the default scene, [`BUILTIN`] the
+/// built-in head, else a scene file.
+pub fn scene_by_name(name: Option<&Path>) -> Result<SceneFile, SceneError> {
+    match name {
+        Some(p) if p == Path::new(BUILTIN) => Ok(SceneFile::default()),
+        Some(p) => load_scene(p),
+        None => load_scene(&default_scene_path()),
+    }
+}
+
 /// Reads, parses, validates a scene file and resolves its relative paths against
 /// the file's directory.
 pub fn load_scene(path: &Path) -> Result<SceneFile, SceneError> {
@@ -820,6 +840,22 @@ mod tests {
             }
         }
         blocks
+    }
+
+    #[test]
+    fn scenes_by_name() {
+        let d = scene_by_name(None).unwrap();
+        assert!(
+            d.mesh.as_ref().unwrap().ends_with("LeePerrySmith.glb"),
+            "{d:?}"
+        );
+        assert_eq!(d.mm_per_unit, Some(50.3));
+        assert_eq!(d.textures.uv_origin, UvOrigin::BottomLeft);
+        assert_eq!(
+            scene_by_name(Some(Path::new(BUILTIN))).unwrap(),
+            SceneFile::default()
+        );
+        assert!(scene_by_name(Some(Path::new("no/such.toml"))).is_err());
     }
 
     #[test]
