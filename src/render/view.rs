@@ -29,24 +29,44 @@ pub enum View {
 }
 
 impl View {
+    /// Every view, in the order `--help` lists them.
+    pub const ALL: [View; 14] = [
+        View::Final,
+        View::Diffuse,
+        View::Specular,
+        View::Direct,
+        View::Occlusion,
+        View::Irradiance,
+        View::Stretch,
+        View::Blur(1),
+        View::Blur(2),
+        View::Blur(3),
+        View::Blur(4),
+        View::Blur(5),
+        View::Blur(6),
+        View::Prefiltered,
+    ];
+
+    /// The command-line name: `final`, …, `blur1`…`blur6`, `prefiltered`.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Final => "final",
+            View::Diffuse => "diffuse",
+            View::Specular => "specular",
+            View::Direct => "direct",
+            View::Occlusion => "occlusion",
+            View::Irradiance => "irradiance",
+            View::Stretch => "stretch",
+            View::Blur(k) => ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"]
+                [(k.clamp(1, 6) - 1) as usize],
+            View::Prefiltered => "prefiltered",
+        }
+    }
+
     pub fn parse(s: &str) -> Result<View> {
-        Ok(match s {
-            "final" => View::Final,
-            "diffuse" => View::Diffuse,
-            "specular" => View::Specular,
-            "direct" => View::Direct,
-            "occlusion" => View::Occlusion,
-            "irradiance" => View::Irradiance,
-            "stretch" => View::Stretch,
-            "prefiltered" => View::Prefiltered,
-            _ => match s.strip_prefix("blur").and_then(|k| k.parse::<u8>().ok()) {
-                Some(k @ 1..=6) => View::Blur(k),
-                _ => {
-                    return Err(Error::Input(format!(
-                    "unknown view {s:?}: final, diffuse, specular, direct, occlusion, irradiance, stretch, blur1..blur6, prefiltered"
-                )))
-                }
-            },
+        Self::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Self::ALL.iter().map(|v| v.name()).collect();
+            Error::Input(format!("unknown view {s:?}: {}", names.join(", ")))
         })
     }
 
@@ -66,5 +86,30 @@ impl View {
             v if v.uv_space() => (irradiance_resolution, irradiance_resolution),
             _ => screen,
         }
+    }
+}
+
+impl clap::ValueEnum for View {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Self::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for v in View::ALL {
+            assert_eq!(View::parse(v.name()).unwrap(), v);
+        }
+        assert_eq!(View::parse("blur4").unwrap(), View::Blur(4));
+        let e = View::parse("blur7").unwrap_err().to_string();
+        assert!(e.contains("blur6") && e.contains("prefiltered"), "{e}");
     }
 }

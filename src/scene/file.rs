@@ -116,7 +116,7 @@ pub struct Textures {
 }
 
 /// The texture corner at UV (0, 0), i.e. the image row that v = 0 samples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum UvOrigin {
     /// glTF 2.0 (UV (0, 0) is "the upper left corner of a texture image"),
@@ -304,12 +304,12 @@ pub enum Kernel {
 }
 
 /// How the per-vertex SH transfer's visibility is computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Occlusion {
-    /// Cube-map rasterised visibility.
+    /// The paper's cube maps rasterised per vertex on the GPU.
     Raster,
-    /// Ray-traced visibility.
+    /// Rays cast on the CPU (the default).
     Raytrace,
     /// No self-occlusion (unshadowed transfer).
     Off,
