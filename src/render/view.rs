@@ -50,6 +50,21 @@ impl View {
         })
     }
 
+    /// The name [`View::parse`] reads.
+    pub fn name(self) -> String {
+        match self {
+            View::Final => "final".into(),
+            View::Diffuse => "diffuse".into(),
+            View::Specular => "specular".into(),
+            View::Direct => "direct".into(),
+            View::Occlusion => "occlusion".into(),
+            View::Irradiance => "irradiance".into(),
+            View::Stretch => "stretch".into(),
+            View::Blur(k) => format!("blur{k}"),
+            View::Prefiltered => "prefiltered".into(),
+        }
+    }
+
     /// Whether the view is an intermediate texture rather than a screen image:
     /// read back as stored, without tone mapping.
     pub fn uv_space(self) -> bool {
@@ -65,6 +80,28 @@ impl View {
             View::Prefiltered => (prefilter::WIDTH, prefilter::HEIGHT * prefilter::LEVELS),
             v if v.uv_space() => (irradiance_resolution, irradiance_resolution),
             _ => screen,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_back() {
+        let all = [
+            "final",
+            "diffuse",
+            "specular",
+            "direct",
+            "occlusion",
+            "irradiance",
+        ]
+        .into_iter()
+        .chain(["stretch", "blur1", "blur6", "prefiltered"]);
+        for name in all {
+            assert_eq!(View::parse(name).unwrap().name(), name);
         }
     }
 }
