@@ -1,6 +1,7 @@
 //! Compiles every shader under `shaders-glsl/` to SPIR-V with glslang (the `glslang`
 //! crate builds the reference compiler from source, no system tool), and writes
 //! `$OUT_DIR/shaders.rs`: a table of (name, SPIR-V words) embedded in the binary.
+//! Also sets `DERMIS_GIT_COMMIT` (for run reports) to the short commit hash.
 
 use glslang::include::{IncludeHandler, IncludeResult, IncludeType};
 use glslang::{
@@ -53,8 +54,64 @@ fn stage_of(path: &Path) -> Option<ShaderStage> {
     }
 }
 
+/// `git rev-parse --short HEAD`, or "unknown" without git; `DERMIS_GIT_COMMIT` in
+/// the environment wins (builds from a tarball). Reruns only when HEAD or the
+/// branch it names moves (worktrees keep HEAD apart from the refs).
+fn git_commit(manifest: &Path) {
+    println!("cargo:rerun-if-env-changed=DERMIS_GIT_COMMIT");
+    if let Ok(given) = std::env::var("DERMIS_GIT_COMMIT") {
+        println!("cargo:rustc-env=DERMIS_GIT_COMMIT={given}");
+        return;
+    }
+    let git = |args: &[&str]| -> Option<String> {
+        let out = std::process::Command::new("git")
+            .args(args)
+            .current_dir(manifest)
+            .output()
+            .ok()?;
+        let text = String::from_utf8(out.stdout).ok()?;
+        (out.status.success() && !text.trim().is_empty()).then(|| text.trim().to_string())
+    };
+    let commit = git(&["rev-parse", "--short", "HEAD"]);
+    let abs = |p: String| {
+        let p = PathBuf::from(p);
+        if p.is_absolute() {
+            p
+        } else {
+            manifest.join(p)
+        }
+    };
+    // A path cargo cannot find makes it rerun every build: name existing ones only.
+    let watch = |path: &Path| {
+        if path.exists() {
+            println!("cargo:rerun-if-changed={}", path.display());
+        }
+    };
+    if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
+        watch(&abs(dir).join("HEAD"));
+    }
+    if let (Some(common), Some(branch)) = (
+        git(&["rev-parse", "--git-common-dir"]),
+        git(&["symbolic-ref", "-q", "HEAD"]),
+    ) {
+        let common = abs(common);
+        let loose = common.join(branch);
+        // A packed branch gets its loose file on the next commit: watch the folder.
+        if loose.exists() {
+            watch(&loose);
+        } else {
+            watch(loose.parent().unwrap_or(&common));
+        }
+        watch(&common.join("packed-refs"));
+    }
+    let commit = commit.unwrap_or_else(|| "unknown".into());
+    println!("cargo:rustc-env=DERMIS_GIT_COMMIT={commit}");
+}
+
 fn main() {
-    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap()).join("shaders-glsl");
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
+    git_commit(&manifest);
+    let root = manifest.join("shaders-glsl");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     println!("cargo:rerun-if-changed={}", root.display());
     println!("cargo:rerun-if-changed={}", root.join("common").display());

@@ -4,7 +4,8 @@
 //! use). `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 4),
 //! `DERMIS_BENCH_SIZES` (irradiance sides, default "512,1024,2048,4096") and
 //! `DERMIS_BENCH_KERNEL` (`deon7` or `accurate`) tune it. Writes
-//! `target/bench-frame.json` for docs/performance.md.
+//! `target/bench-frame.json` (one run report per size, each with its setup) for
+//! docs/performance.md.
 
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render_scene, RenderOptions};
@@ -35,21 +36,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..RenderOptions::default()
         };
         let r = render_scene(&ctx, &scene, &opts)?.report;
-        println!(
-            "\nirradiance {size}², output {}x{}, on {} ({}), {} measured frames, LP_NUM_THREADS={}",
-            r.width,
-            r.height,
-            r.device,
-            r.driver,
-            r.frames - r.warmup_frames,
-            r.lp_num_threads.as_deref().unwrap_or("unset")
-        );
-        if let Some(m) = &r.median {
-            print!("{}", m.table());
-        }
+        print!("\n{}{}", r.header(), r.table());
         reports.push(r);
     }
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench-frame.json");
+    // target/ is missing when CARGO_TARGET_DIR points elsewhere.
+    std::fs::create_dir_all(path.parent().unwrap())?;
     std::fs::write(&path, serde_json::to_string_pretty(&reports)?)?;
     println!("\nwrote {}", path.display());
     Ok(())

@@ -3,9 +3,10 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{scene_by_name, Occlusion, UvOrigin};
+use dermis::scene::file::{default_scene_path, scene_by_name, Occlusion, UvOrigin};
 use dermis::scene::Overrides;
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -110,12 +111,19 @@ enum Command {
         /// Frames to render; with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
-        /// Print the per-pass GPU time table (median of measured frames).
+        /// Print the per-pass GPU time table (median, min, max, p90 of measured frames).
         #[arg(long)]
         timings: bool,
-        /// Write the frame report (device, driver, per-pass GPU ns) as JSON.
+        /// Write the run report (setup, version, device, per-pass statistics, every
+        /// frame's pass times and starts, memory) as JSON.
         #[arg(long)]
         report: Option<PathBuf>,
+        /// Write the frames and passes as a Chrome trace (Perfetto, chrome://tracing).
+        #[arg(long)]
+        trace: Option<PathBuf>,
+        /// Write one CSV row per pass per frame, with the run's setup in each row.
+        #[arg(long)]
+        csv: Option<PathBuf>,
         /// Print the compiled render graph (passes, barriers, lifetimes).
         #[arg(long)]
         dump_graph: bool,
@@ -129,6 +137,18 @@ fn parse_occlusion(s: &str) -> Result<Occlusion, String> {
         "off" => Ok(Occlusion::Off),
         _ => Err(format!("{s:?}: expected raster, raytrace or off")),
     }
+}
+
+fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String> {
+    serde_json::to_string_pretty(value)
+        .map_err(|e| dermis::Error::Input(format!("{}: {e}", path.display())))
+}
+
+fn write_file(path: &Path, text: &str) -> dermis::Result<()> {
+    std::fs::write(path, text).map_err(|source| dermis::Error::Io {
+        path: path.display().to_string(),
+        source,
+    })
 }
 
 fn main() -> ExitCode {
@@ -264,6 +284,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
             frames,
             timings,
             report,
+            trace,
+            csv,
             dump_graph,
         } => {
             let file = scene_by_name(scene.as_deref())?;
@@ -287,28 +309,25 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 hdr,
                 view: View::parse(&view)?,
                 context,
+                scene_path: Some(scene.unwrap_or_else(default_scene_path)),
+                progress: std::io::stderr().is_terminal(),
             })?;
             if dump_graph {
                 print!("{}", output.plan);
             }
             dermis::render::output::write(&out, &output)?;
+            let r = &output.report;
             if timings {
-                let r = &output.report;
-                println!(
-                    "{} ({}), {}x{}, {} frame(s), {} warm-up",
-                    r.device, r.driver, r.width, r.height, r.frames, r.warmup_frames
-                );
-                if let Some(m) = &r.median {
-                    print!("{}", m.table());
-                }
+                print!("{}{}", r.header(), r.table());
             }
             if let Some(path) = report {
-                let json = serde_json::to_string_pretty(&output.report)
-                    .map_err(|e| dermis::Error::Input(format!("{}: {e}", path.display())))?;
-                std::fs::write(&path, json).map_err(|source| dermis::Error::Io {
-                    path: path.display().to_string(),
-                    source,
-                })?;
+                write_file(&path, &to_json(&path, r)?)?;
+            }
+            if let Some(path) = trace {
+                write_file(&path, &to_json(&path, &dermis::profile::trace::trace(r))?)?;
+            }
+            if let Some(path) = csv {
+                write_file(&path, &dermis::profile::csv::csv(r))?;
             }
             println!("wrote {}", out.display());
             Ok(())

@@ -70,6 +70,166 @@ fn render_writes_png_report_and_graph() {
     assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
 }
 
+/// Splits a CSV line, honouring quoted fields (with "" for a quote).
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+            c => cur.push(c),
+        }
+    }
+    fields.push(cur);
+    fields
+}
+
+#[test]
+fn render_writes_self_describing_report_trace_and_csv() {
+    let (json, trace, csv) = (tmp("r.json"), tmp("t.json"), tmp("c.csv"));
+    let out = dermis(&[
+        "render",
+        "--out",
+        tmp("describe.png").to_str().unwrap(),
+        "--irradiance-res",
+        "256",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "3",
+        "--report",
+        json.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    let read = |p: &PathBuf| std::fs::read_to_string(p).unwrap();
+
+    // The report says what ran.
+    let r: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    let setup = &r["setup"];
+    assert_eq!(setup["irradiance_resolution"], 256);
+    assert_eq!(setup["view"], "final");
+    assert_eq!(setup["kernel"], "deon7");
+    assert_eq!(setup["chain"], "full");
+    assert_eq!(setup["scene"], "default");
+    // The default scene's mesh: "builtin" or the scan's path.
+    assert!(setup["mesh"].as_str().is_some_and(|m| !m.is_empty()));
+    assert_eq!(
+        (
+            setup["render_width"].clone(),
+            setup["render_height"].clone()
+        ),
+        (64.into(), 48.into())
+    );
+    assert!(setup["environment"].as_str().is_some_and(|e| !e.is_empty()));
+    assert!(setup["occlusion"].is_string());
+    assert_eq!(r["dermis_version"], env!("CARGO_PKG_VERSION"));
+    assert!(r["git_commit"].as_str().is_some_and(|c| !c.is_empty()));
+    assert!(r["clock"] == "host-fence" || r["clock"] == "gpu-timestamp");
+    let memory = &r["memory"];
+    let bytes = |k: &str| memory[k].as_u64().unwrap();
+    assert!(bytes("transient_pool_bytes") > 0);
+    assert!(bytes("allocated_bytes") >= bytes("transient_pool_bytes"));
+    assert!(bytes("reserved_bytes") >= bytes("allocated_bytes"));
+    let passes = r["passes"].as_array().unwrap();
+    assert!(passes.len() > 5);
+    for p in passes {
+        assert_eq!(p["frames"], 2, "{p}");
+        let v = |k: &str| p[k].as_f64().unwrap();
+        assert!(
+            v("min_ns") <= v("median_ns") && v("median_ns") <= v("p90_ns"),
+            "{p}"
+        );
+        assert!(v("p90_ns") <= v("max_ns"), "{p}");
+    }
+    let frames = r["per_frame"].as_array().unwrap();
+    assert_eq!(frames.len(), 3);
+    assert!(frames
+        .iter()
+        .flat_map(|f| f["passes"].as_array().unwrap())
+        .all(|p| p["start_ns"].as_f64().is_some_and(|s| s >= 0.0)));
+
+    // The trace parses; every pass lies in its frame, passes of a frame apart.
+    let t: serde_json::Value = serde_json::from_str(&read(&trace)).unwrap();
+    let events = t["traceEvents"].as_array().unwrap();
+    let of = |cat: &'static str| events.iter().filter(move |e| e["cat"] == cat);
+    let span = |e: &serde_json::Value| {
+        assert_eq!(e["ph"], "X");
+        let ts = e["ts"].as_f64().unwrap();
+        (ts, ts + e["dur"].as_f64().unwrap())
+    };
+    const EPS: f64 = 1e-6; // µs
+    assert_eq!(of("frame").count(), 3);
+    for (f, report) in of("frame").zip(frames) {
+        let (f0, f1) = span(f);
+        let mut inside: Vec<_> = of("pass")
+            .filter(|p| p["args"]["frame"] == f["args"]["frame"])
+            .map(span)
+            .collect();
+        assert_eq!(inside.len(), report["passes"].as_array().unwrap().len());
+        inside.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for &(p0, p1) in &inside {
+            assert!(
+                f0 <= p0 + EPS && p1 <= f1 + EPS,
+                "{p0}..{p1} outside {f0}..{f1}"
+            );
+        }
+        for w in inside.windows(2) {
+            assert!(w[0].1 <= w[1].0 + EPS, "overlap: {w:?}");
+        }
+    }
+
+    // The CSV: a header, then one row per pass per frame, every row complete.
+    let text = read(&csv);
+    let lines: Vec<&str> = text.lines().collect();
+    let header = csv_fields(lines[0]);
+    for column in [
+        "frame",
+        "pass",
+        "start_ns",
+        "duration_ns",
+        "clock",
+        "irradiance_resolution",
+        "kernel",
+        "view",
+    ] {
+        assert!(header.iter().any(|h| h == column), "{column} in {header:?}");
+    }
+    let per_frame: Vec<usize> = frames
+        .iter()
+        .map(|f| f["passes"].as_array().unwrap().len())
+        .collect();
+    // Frames after the first run the same passes (the first also prefilters).
+    assert_eq!(per_frame[1], per_frame[2]);
+    assert!(per_frame[0] >= per_frame[1]);
+    assert_eq!(lines.len() - 1, per_frame.iter().sum::<usize>());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mut rows_per_frame = [0usize; 3];
+    for line in &lines[1..] {
+        let row = csv_fields(line);
+        assert_eq!(row.len(), header.len(), "{line}");
+        assert_eq!(row[col("irradiance_resolution")], "256");
+        assert_eq!(row[col("view")], "final");
+        rows_per_frame[row[col("frame")].parse::<usize>().unwrap()] += 1;
+    }
+    assert_eq!(rows_per_frame.to_vec(), per_frame);
+}
+
 #[test]
 fn info_json_describes_the_device() {
     let out = dermis(&["info", "--json"]);

@@ -1,5 +1,5 @@
-//! Per-pass timing: every pass of a frame gets a positive duration and the passes
-//! fit inside the frame's span, with both clocks.
+//! Per-pass timing: every pass of a frame gets a positive duration and a start,
+//! and the passes fit inside the frame's span, with both clocks.
 
 mod common;
 
@@ -49,7 +49,30 @@ fn check(reports: &[FrameReport], clock: &str) {
             r.gpu_pass_sum_ns()
         );
         assert_eq!(r.dropped_deltas, 0);
+        // Passes start in order and end within the frame.
+        let mut previous_end = 0.0;
+        for p in &r.passes {
+            let start = p
+                .start_ns
+                .unwrap_or_else(|| panic!("{} has no start", p.name));
+            let end = start + p.gpu_ns.unwrap();
+            assert!(
+                start >= previous_end,
+                "{} starts before the last ends: {r:?}",
+                p.name
+            );
+            assert!(
+                end <= span,
+                "{} ends at {end}, after the frame ({span})",
+                p.name
+            );
+            previous_end = end;
+        }
     }
+    // Frames are placed on one timeline from the first frame's start.
+    let starts: Vec<f64> = reports.iter().map(|r| r.start_ns.unwrap()).collect();
+    assert_eq!(starts[0], 0.0);
+    assert!(starts.windows(2).all(|w| w[0] < w[1]), "{starts:?}");
     let json = serde_json::to_string(&reports[0]).unwrap();
     assert!(json.contains("\"blur_h\""));
 }

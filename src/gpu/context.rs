@@ -187,6 +187,13 @@ impl Context {
         self.allocator.lock().unwrap_or_else(|p| p.into_inner())
     }
 
+    /// gpu-allocator's totals now: (bytes in live allocations, bytes of device
+    /// memory blocks it holds).
+    pub fn allocator_bytes(&self) -> (u64, u64) {
+        let report = self.allocator().generate_report();
+        (report.total_allocated_bytes, report.total_capacity_bytes)
+    }
+
     pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
         self.queue.lock().unwrap_or_else(|p| p.into_inner())
     }

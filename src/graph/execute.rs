@@ -70,6 +70,10 @@ pub struct Executor {
     frame: u64,
     pool: PoolState,
     pool_images: Vec<Option<Image>>,
+    /// The first frame's start, that later frames' starts count from: a raw
+    /// timestamp (GPU clock) and an instant (host clock).
+    gpu_epoch: Option<u64>,
+    host_epoch: Option<Instant>,
 }
 
 impl Executor {
@@ -83,6 +87,8 @@ impl Executor {
             frame: 0,
             pool: PoolState::default(),
             pool_images: Vec::new(),
+            gpu_epoch: None,
+            host_epoch: None,
         };
         for _ in 0..frames_in_flight.max(1) {
             let slot = ex.new_slot()?;
@@ -209,9 +215,10 @@ impl Executor {
         unsafe { self.ctx.device.queue_submit2(*queue, &submit, slot.fence) }.vk("vkQueueSubmit2")
     }
 
-    /// [`Clock::HostFence`]: each pass is its own submission, waited for and timed.
+    /// [`Clock::HostFence`]: each pass is its own submission, waited for and timed
+    /// from submit to fence; its start is the submit's offset from the frame's.
     fn run_isolated(
-        &self,
+        &mut self,
         index: usize,
         c: &Compiled,
         images: &[Option<ResolvedImage>],
@@ -221,6 +228,7 @@ impl Executor {
         let fence = self.slots[index].fence;
         let d = &self.ctx.device;
         let frame_start = Instant::now();
+        let epoch = *self.host_epoch.get_or_insert(frame_start);
         let (mut record_ns, mut submit_ns) = (0.0, 0.0);
         let mut passes = Vec::with_capacity(names.len());
         for i in 0..names.len().max(1) {
@@ -238,11 +246,13 @@ impl Executor {
                 passes.push(PassTime {
                     name: name.clone(),
                     gpu_ns: Some((t3 - t1).as_nanos() as f64),
+                    start_ns: Some((t1 - frame_start).as_nanos() as f64),
                 });
             }
         }
         Ok(FrameReport {
             frame: self.frame,
+            start_ns: Some((frame_start - epoch).as_nanos() as f64),
             passes,
             gpu_frame_ns: Some(frame_start.elapsed().as_nanos() as f64),
             cpu_record_ns: record_ns,
@@ -295,13 +305,22 @@ impl Executor {
             }
             .vk("vkGetQueryPoolResults")?;
             let info = &self.ctx.info;
-            FrameReport::from_timestamps(
+            let mut report = FrameReport::from_timestamps(
                 done.frame,
                 &done.pass_names,
                 &raw,
                 info.timestamp_valid_bits,
                 info.timestamp_period_ns,
-            )
+            );
+            // Frames retire in order: the first one retired sets the epoch.
+            let epoch = *self.gpu_epoch.get_or_insert(raw[0]);
+            let mask = match info.timestamp_valid_bits {
+                64.. => u64::MAX,
+                bits => (1u64 << bits) - 1,
+            };
+            let ticks = raw[0].wrapping_sub(epoch) & mask;
+            report.start_ns = Some(ticks as f64 * info.timestamp_period_ns as f64);
+            report
         } else {
             // No timestamps on this device: passes are listed without GPU times.
             FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)

@@ -1,20 +1,33 @@
-//! Frame reports: per-pass GPU time from timestamps, CPU record/submit time, and
-//! medians over warmed-up frames.
+//! Frame reports: per-pass GPU time and start within the frame, CPU record/submit
+//! time; run reports with statistics over warmed-up frames; trace and CSV output.
+
+pub mod csv;
+mod run;
+mod stats;
+pub mod trace;
+
+pub use run::{MemoryUse, PassStats, RunReport, RunSetup};
+pub use stats::Stats;
 
 use serde::Serialize;
 
 /// GPU time of one pass of one frame.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct PassTime {
     pub name: String,
     /// `None` when the device has no timestamps or the delta was not positive.
     pub gpu_ns: Option<f64>,
+    /// From the frame's start (first timestamp, or host start with host fences)
+    /// to the pass's start.
+    pub start_ns: Option<f64>,
 }
 
 /// What one frame cost.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct FrameReport {
     pub frame: u64,
+    /// The frame's start after the executor's first frame's, on the same clock.
+    pub start_ns: Option<f64>,
     pub passes: Vec<PassTime>,
     /// From a timestamp before the first pass to one after the last.
     pub gpu_frame_ns: Option<f64>,
@@ -37,7 +50,8 @@ impl FrameReport {
     }
 
     /// Turns raw 64-bit timestamps (frame begin, frame end, then begin/end per pass)
-    /// into durations: masked to `valid_bits`, scaled by `period_ns`.
+    /// into durations and starts within the frame: masked to `valid_bits`, scaled
+    /// by `period_ns`.
     pub fn from_timestamps(
         frame: u64,
         names: &[String],
@@ -60,12 +74,18 @@ impl FrameReport {
             Some((b - a) as f64 * period_ns as f64)
         };
         let gpu_frame_ns = delta(raw.first(), raw.get(1));
+        // A pass may start on the frame's first tick: offsets of 0 are kept.
+        let offset = |b: Option<&u64>| -> Option<f64> {
+            let (a, b) = (raw.first()? & mask, b? & mask);
+            (b >= a).then(|| (b - a) as f64 * period_ns as f64)
+        };
         let passes = names
             .iter()
             .enumerate()
             .map(|(i, name)| PassTime {
                 name: name.clone(),
                 gpu_ns: delta(raw.get(2 + 2 * i), raw.get(3 + 2 * i)),
+                start_ns: offset(raw.get(2 + 2 * i)),
             })
             .collect();
         FrameReport {
@@ -78,31 +98,30 @@ impl FrameReport {
         }
     }
 
-    /// Per-pass medians over several frames (same pass list), e.g. after warm-up.
+    pub fn pass_start_ns(&self, name: &str) -> Option<f64> {
+        self.passes.iter().find(|p| p.name == name)?.start_ns
+    }
+
+    /// Per-pass medians (times and starts) over several frames (same pass list),
+    /// e.g. after warm-up.
     pub fn median(frames: &[FrameReport]) -> Option<FrameReport> {
         let last = frames.last()?;
-        let med = |mut v: Vec<f64>| -> Option<f64> {
-            if v.is_empty() {
-                return None;
-            }
-            v.sort_by(f64::total_cmp);
-            let n = v.len();
-            Some(if n % 2 == 1 {
-                v[n / 2]
-            } else {
-                0.5 * (v[n / 2 - 1] + v[n / 2])
-            })
-        };
+        let med = |v: Vec<f64>| stats::median(&v);
         let passes = last
             .passes
             .iter()
             .map(|p| PassTime {
                 name: p.name.clone(),
                 gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
+                start_ns: med(frames
+                    .iter()
+                    .filter_map(|f| f.pass_start_ns(&p.name))
+                    .collect()),
             })
             .collect();
         Some(FrameReport {
             frame: last.frame,
+            start_ns: None,
             passes,
             gpu_frame_ns: med(frames.iter().filter_map(|f| f.gpu_frame_ns).collect()),
             cpu_record_ns: med(frames.iter().map(|f| f.cpu_record_ns).collect()).unwrap_or(0.0),
@@ -163,6 +182,19 @@ mod tests {
         assert_eq!(r.pass_ns("a"), Some(800.0));
         assert_eq!(r.pass_ns("b"), None);
         assert_eq!(r.dropped_deltas, 1);
+        // Starts from the (masked) frame begin: (200 - 100) × 2, (700 - 100) × 2.
+        assert_eq!(r.pass_start_ns("a"), Some(200.0));
+        assert_eq!(r.pass_start_ns("b"), Some(1200.0));
+    }
+
+    #[test]
+    fn a_pass_before_the_frame_begin_has_no_start() {
+        let names = vec!["a".to_string()];
+        let r = FrameReport::from_timestamps(0, &names, &[500, 900, 500, 600], 64, 1.0);
+        assert_eq!(r.pass_start_ns("a"), Some(0.0));
+        let r = FrameReport::from_timestamps(0, &names, &[500, 900, 400, 600], 64, 1.0);
+        assert_eq!(r.pass_start_ns("a"), None);
+        assert_eq!(r.pass_ns("a"), Some(200.0));
     }
 
     #[test]
@@ -171,58 +203,14 @@ mod tests {
             passes: vec![PassTime {
                 name: "p".into(),
                 gpu_ns: Some(v),
+                start_ns: Some(v + 1.0),
             }],
             gpu_frame_ns: Some(v * 2.0),
             ..Default::default()
         };
         let m = FrameReport::median(&[f(5.0), f(1.0), f(3.0), f(100.0)]).unwrap();
         assert_eq!(m.pass_ns("p"), Some(4.0));
+        assert_eq!(m.pass_start_ns("p"), Some(5.0));
         assert_eq!(m.gpu_frame_ns, Some(8.0));
-    }
-}
-
-/// What `--report FILE.json` writes: the device, the setup, and the timings.
-#[derive(Clone, Debug, Serialize)]
-pub struct RunReport {
-    pub device: String,
-    pub device_type: String,
-    pub driver: String,
-    pub api_version: String,
-    /// `LP_NUM_THREADS` (lavapipe's rasterizer thread count), when set.
-    pub lp_num_threads: Option<String>,
-    pub width: u32,
-    pub height: u32,
-    pub frames: usize,
-    pub warmup_frames: usize,
-    /// Bytes of device memory held by pooled transient images.
-    pub transient_bytes: u64,
-    /// Per-pass medians over the measured (post-warm-up) frames.
-    pub median: Option<FrameReport>,
-    pub per_frame: Vec<FrameReport>,
-}
-
-impl RunReport {
-    pub fn new(
-        device: &crate::gpu::DeviceInfo,
-        width: u32,
-        height: u32,
-        per_frame: Vec<FrameReport>,
-        transient_bytes: u64,
-    ) -> Self {
-        let warmup = usize::from(per_frame.len() > 1);
-        Self {
-            device: device.name.clone(),
-            device_type: device.device_type.clone(),
-            driver: format!("{} {}", device.driver_name, device.driver_info),
-            api_version: device.api_version.clone(),
-            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
-            width,
-            height,
-            frames: per_frame.len(),
-            warmup_frames: warmup,
-            transient_bytes,
-            median: FrameReport::median(&per_frame[warmup.min(per_frame.len())..]),
-            per_frame,
-        }
     }
 }

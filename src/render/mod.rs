@@ -4,6 +4,7 @@
 
 mod frame;
 pub mod output;
+mod progress;
 mod view;
 
 pub use view::View;
@@ -13,11 +14,13 @@ use crate::gpu::{Context, ContextOptions, DeviceInfo};
 use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph};
 use crate::post::tonemap::encode8;
-use crate::profile::RunReport;
-use crate::scene::file::SceneFile;
+use crate::profile::{MemoryUse, RunReport, RunSetup};
+use crate::scene::file::{Kernel, Occlusion, SceneFile};
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
 use frame::Frame;
+use progress::Progress;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
@@ -31,6 +34,10 @@ pub struct RenderOptions {
     pub hdr: bool,
     pub view: View,
     pub context: ContextOptions,
+    /// Where `scene` was read from, for the report (`None`: the default scene).
+    pub scene_path: Option<PathBuf>,
+    /// Show a progress bar on stderr (the caller checks it is a terminal).
+    pub progress: bool,
 }
 
 impl Default for RenderOptions {
@@ -41,7 +48,45 @@ impl Default for RenderOptions {
             hdr: false,
             view: View::Final,
             context: ContextOptions::from_env(),
+            scene_path: None,
+            progress: false,
         }
+    }
+}
+
+/// The diffusion chain's variant; one today.
+const CHAIN: &str = "full";
+
+/// What the report says was rendered.
+fn setup(scene: &Scene, opts: &RenderOptions, irradiance_resolution: u32) -> RunSetup {
+    let f = &scene.file;
+    let path = |p: &Option<PathBuf>, none: &str| {
+        p.as_ref()
+            .map_or_else(|| none.to_string(), |p| p.display().to_string())
+    };
+    RunSetup {
+        scene: path(&opts.scene_path, "default"),
+        mesh: path(&f.mesh, "builtin"),
+        environment: f.environment.source.to_string(),
+        environment_rotation_deg: f.environment.rotation_deg,
+        irradiance_resolution,
+        kernel: match f.skin.kernel {
+            Kernel::Deon7 => "deon7",
+            Kernel::Accurate => "accurate",
+        }
+        .into(),
+        chain: CHAIN.into(),
+        view: opts.view.name().into(),
+        render_width: f.render.width,
+        render_height: f.render.height,
+        occlusion: match f.skin.occlusion {
+            Occlusion::Raster => "raster",
+            Occlusion::Raytrace => "raytrace",
+            Occlusion::Off => "off",
+        }
+        .into(),
+        shadow_resolution: f.render.shadow_resolution,
+        lights: f.lights.len(),
     }
 }
 
@@ -89,6 +134,7 @@ pub fn render_scene(
     check_target(&ctx.info, screen.0, screen.1)?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
+    let run_setup = setup(scene, opts, skin.resolution);
     let (w, h) = opts.view.size(screen, skin.resolution);
     let frame = Frame::new(ctx, scene, skin)?;
     let readback = |name: &str, bytes_per_texel: u64| {
@@ -109,6 +155,7 @@ pub fn render_scene(
     let mut executor = Executor::new(ctx, 2)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
+    let progress = Progress::new(opts.frames, opts.progress);
     for i in 0..opts.frames {
         let mut g = Graph::new();
         let (hdr, ldr) = frame.graph(&mut g, opts.view, screen, i == 0);
@@ -121,8 +168,10 @@ pub fn render_scene(
         let compiled = executor.compile(g)?;
         plan = compiled.plan.to_string();
         reports.extend(executor.submit(compiled)?);
+        progress.update(reports.len(), reports.last().and_then(|r| r.gpu_frame_ns));
     }
     reports.extend(executor.finish()?);
+    drop(progress);
     let exposure = frame.exposure_for(opts.view);
     // Screen views: linear radiance × 2^exposure. UV views: the values as stored.
     let hdr = match &hdr_readback {
@@ -142,7 +191,13 @@ pub fn render_scene(
         (None, Some(values)) => encode8(values, exposure, scene.file.render.gamma),
         (None, None) => Vec::new(),
     };
-    let report = RunReport::new(&ctx.info, w, h, reports, executor.pool_bytes());
+    let (allocated_bytes, reserved_bytes) = ctx.allocator_bytes();
+    let memory = MemoryUse {
+        transient_pool_bytes: executor.pool_bytes(),
+        allocated_bytes,
+        reserved_bytes,
+    };
+    let report = RunReport::new(&ctx.info, run_setup, w, h, reports, memory);
     Ok(RenderOutput {
         width: w,
         height: h,

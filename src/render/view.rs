@@ -57,17 +57,21 @@ impl View {
             View::Occlusion => "occlusion",
             View::Irradiance => "irradiance",
             View::Stretch => "stretch",
-            View::Blur(k) => ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"]
-                [(k.clamp(1, 6) - 1) as usize],
+            View::Blur(k) => {
+                ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"][(k.clamp(1, 6) - 1) as usize]
+            }
             View::Prefiltered => "prefiltered",
         }
     }
 
     pub fn parse(s: &str) -> Result<View> {
-        Self::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|v| v.name()).collect();
-            Error::Input(format!("unknown view {s:?}: {}", names.join(", ")))
-        })
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|v| v.name()).collect();
+                Error::Input(format!("unknown view {s:?}: {}", names.join(", ")))
+            })
     }
 
     /// Whether the view is an intermediate texture rather than a screen image:

@@ -1,0 +1,356 @@
+//! What `--report FILE.json` writes: what was run, where, and what it cost.
+
+use super::stats::Stats;
+use super::FrameReport;
+use crate::gpu::DeviceInfo;
+use serde::Serialize;
+
+/// The dermis version the report was made by.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+/// `git rev-parse --short HEAD` at build time (build.rs), or "unknown".
+pub const GIT_COMMIT: &str = env!("DERMIS_GIT_COMMIT");
+
+/// What was rendered, as the caller resolved it: enough to run it again.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RunSetup {
+    /// The scene file, or "default".
+    pub scene: String,
+    /// The glTF mesh, or "builtin".
+    pub mesh: String,
+    /// The environment source as given (`sky…`, `uniform:…`, a file).
+    pub environment: String,
+    pub environment_rotation_deg: f32,
+    /// Side of the UV-space irradiance texture.
+    pub irradiance_resolution: u32,
+    /// Blur kernel: `deon7` or `accurate`.
+    pub kernel: String,
+    /// Which passes the diffusion chain runs (today always `full`).
+    pub chain: String,
+    /// `final` or the intermediate written.
+    pub view: String,
+    /// Screen size rendered at (the output size is the report's width × height).
+    pub render_width: u32,
+    pub render_height: u32,
+    /// Occlusion method: `raster`, `raytrace` or `off`.
+    pub occlusion: String,
+    pub shadow_resolution: u32,
+    pub lights: usize,
+}
+
+/// Device memory at the end of the run.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct MemoryUse {
+    /// Pooled transient images of the render graph.
+    pub transient_pool_bytes: u64,
+    /// gpu-allocator: bytes of live allocations (the pool included).
+    pub allocated_bytes: u64,
+    /// gpu-allocator: bytes of device memory blocks it holds.
+    pub reserved_bytes: u64,
+}
+
+/// One pass (or the frame span) over the measured frames.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassStats {
+    pub name: String,
+    /// Measured frames that timed it.
+    pub frames: usize,
+    /// `None` when no frame timed it.
+    #[serde(flatten)]
+    pub time: Option<Stats>,
+}
+
+impl PassStats {
+    fn of(name: &str, values: Vec<f64>) -> Self {
+        Self {
+            name: name.into(),
+            frames: values.iter().filter(|v| v.is_finite()).count(),
+            time: Stats::of(&values),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    pub dermis_version: String,
+    pub git_commit: String,
+    pub setup: RunSetup,
+    pub device: String,
+    pub device_type: String,
+    pub driver: String,
+    pub api_version: String,
+    /// `LP_NUM_THREADS` (lavapipe's rasterizer thread count), when set.
+    pub lp_num_threads: Option<String>,
+    /// What measured the passes: "gpu-timestamp" or "host-fence".
+    pub clock: String,
+    /// Output image size.
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub warmup_frames: usize,
+    /// Same as `memory.transient_pool_bytes` (kept for older readers).
+    pub transient_bytes: u64,
+    pub memory: MemoryUse,
+    /// Per pass over the measured (post-warm-up) frames, in first-seen order.
+    pub passes: Vec<PassStats>,
+    /// The frame's GPU span over the measured frames.
+    pub frame_span: PassStats,
+    /// Per-pass medians over the measured frames.
+    pub median: Option<FrameReport>,
+    pub per_frame: Vec<FrameReport>,
+}
+
+impl RunReport {
+    /// With more than one frame the first is warm-up, outside the statistics.
+    pub fn new(
+        device: &DeviceInfo,
+        setup: RunSetup,
+        width: u32,
+        height: u32,
+        per_frame: Vec<FrameReport>,
+        memory: MemoryUse,
+    ) -> Self {
+        let warmup = usize::from(per_frame.len() > 1);
+        let measured = &per_frame[warmup.min(per_frame.len())..];
+        let mut names: Vec<&str> = Vec::new();
+        for p in measured.iter().flat_map(|f| &f.passes) {
+            if !names.contains(&p.name.as_str()) {
+                names.push(&p.name);
+            }
+        }
+        let passes = names
+            .iter()
+            .map(|n| {
+                let v = measured.iter().filter_map(|f| f.pass_ns(n)).collect();
+                PassStats::of(n, v)
+            })
+            .collect();
+        let spans = measured.iter().filter_map(|f| f.gpu_frame_ns).collect();
+        Self {
+            dermis_version: VERSION.into(),
+            git_commit: GIT_COMMIT.into(),
+            setup,
+            device: device.name.clone(),
+            device_type: device.device_type.clone(),
+            driver: format!("{} {}", device.driver_name, device.driver_info),
+            api_version: device.api_version.clone(),
+            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+            clock: per_frame
+                .first()
+                .map_or_else(|| "none".into(), |f| f.clock.clone()),
+            width,
+            height,
+            frames: per_frame.len(),
+            warmup_frames: warmup,
+            transient_bytes: memory.transient_pool_bytes,
+            memory,
+            passes,
+            frame_span: PassStats::of("frame (GPU span)", spans),
+            median: FrameReport::median(measured),
+            per_frame,
+        }
+    }
+
+    /// Two lines: the device and the setup.
+    pub fn header(&self) -> String {
+        let s = &self.setup;
+        format!(
+            "{} ({}), API {}, LP_NUM_THREADS={}, dermis {} ({})\n\
+             {} {}x{} (render {}x{}), irradiance {}², kernel {}, chain {}, occlusion {}, \
+             mesh {}, env {} @ {}°, {} frame(s), {} warm-up\n",
+            self.device,
+            self.driver.trim(),
+            self.api_version,
+            self.lp_num_threads.as_deref().unwrap_or("unset"),
+            self.dermis_version,
+            self.git_commit,
+            s.view,
+            self.width,
+            self.height,
+            s.render_width,
+            s.render_height,
+            s.irradiance_resolution,
+            s.kernel,
+            s.chain,
+            s.occlusion,
+            s.mesh,
+            s.environment,
+            s.environment_rotation_deg,
+            self.frames,
+            self.warmup_frames,
+        )
+    }
+
+    /// Per pass: median, min, max, p90 over the measured frames, and their count.
+    pub fn table(&self) -> String {
+        let ms = |ns: Option<f64>| ns.map_or("n/a".to_string(), |v| format!("{:.3}", v / 1e6));
+        let row = |name: &str, frames: usize, t: Option<Stats>| {
+            format!(
+                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}\n",
+                name,
+                ms(t.map(|t| t.median_ns)),
+                ms(t.map(|t| t.min_ns)),
+                ms(t.map(|t| t.max_ns)),
+                ms(t.map(|t| t.p90_ns)),
+                frames
+            )
+        };
+        let mut s = format!(
+            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}   (ms; clock: {})\n",
+            "pass", "median", "min", "max", "p90", "frames", self.clock
+        );
+        for p in &self.passes {
+            s += &row(&p.name, p.frames, p.time);
+        }
+        let sum: f64 = self
+            .passes
+            .iter()
+            .filter_map(|p| p.time.map(|t| t.median_ns))
+            .sum();
+        s += &format!("{:<24} {:>10}\n", "sum of pass medians", ms(Some(sum)));
+        s += &row(
+            &self.frame_span.name,
+            self.frame_span.frames,
+            self.frame_span.time,
+        );
+        let measured = &self.per_frame[self.warmup_frames.min(self.per_frame.len())..];
+        for (name, v) in [
+            (
+                "CPU record",
+                measured.iter().map(|f| f.cpu_record_ns).collect::<Vec<_>>(),
+            ),
+            (
+                "CPU submit",
+                measured.iter().map(|f| f.cpu_submit_ns).collect(),
+            ),
+        ] {
+            s += &row(name, v.len(), Stats::of(&v));
+        }
+        let dropped: u32 = measured.iter().map(|f| f.dropped_deltas).sum();
+        if dropped > 0 {
+            s += &format!("({dropped} non-positive timestamp deltas dropped)\n");
+        }
+        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+        s += &format!(
+            "memory: transient pool {:.1} MiB, allocated {:.1} MiB, reserved {:.1} MiB\n",
+            mib(self.memory.transient_pool_bytes),
+            mib(self.memory.allocated_bytes),
+            mib(self.memory.reserved_bytes)
+        );
+        s
+    }
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+    use crate::profile::PassTime;
+
+    /// Frames of passes "a" (at 10 ns, lasting `a`) and "b" (right after),
+    /// on the host-fence clock, 1000 ns apart.
+    pub fn frames(a: &[f64]) -> Vec<FrameReport> {
+        a.iter()
+            .enumerate()
+            .map(|(i, &a)| FrameReport {
+                frame: i as u64,
+                start_ns: Some(1000.0 * i as f64),
+                passes: vec![
+                    PassTime {
+                        name: "a".into(),
+                        gpu_ns: Some(a),
+                        start_ns: Some(10.0),
+                    },
+                    PassTime {
+                        name: "b".into(),
+                        gpu_ns: Some(5.0),
+                        start_ns: Some(10.0 + a),
+                    },
+                ],
+                gpu_frame_ns: Some(a + 20.0),
+                cpu_record_ns: 1.0,
+                clock: "host-fence".into(),
+                ..Default::default()
+            })
+            .collect()
+    }
+
+    pub fn device() -> DeviceInfo {
+        DeviceInfo {
+            name: "test device, 2 cores".into(),
+            device_type: "CPU".into(),
+            driver_name: "drv".into(),
+            driver_info: "1.0".into(),
+            api_version: "1.3.0".into(),
+            vendor_id: 0,
+            device_id: 0,
+            timestamps: true,
+            timestamp_period_ns: 1.0,
+            timestamp_valid_bits: 64,
+            max_image_dimension_2d: 8192,
+            memory_heaps: Vec::new(),
+            validation: false,
+        }
+    }
+
+    pub fn setup() -> RunSetup {
+        RunSetup {
+            scene: "default".into(),
+            mesh: "builtin".into(),
+            environment: "sky".into(),
+            irradiance_resolution: 256,
+            kernel: "deon7".into(),
+            chain: "full".into(),
+            view: "final".into(),
+            occlusion: "raytrace".into(),
+            ..Default::default()
+        }
+    }
+
+    pub fn report(a: &[f64]) -> RunReport {
+        RunReport::new(&device(), setup(), 64, 48, frames(a), MemoryUse::default())
+    }
+
+    #[test]
+    fn statistics_leave_the_warm_up_out() {
+        // Warm-up 1000, then 40 10 30 20 50: median 30, p90 rank ⌈4.5⌉ = 5 → 50.
+        let r = report(&[1000.0, 40.0, 10.0, 30.0, 20.0, 50.0]);
+        assert_eq!((r.frames, r.warmup_frames), (6, 1));
+        let a = &r.passes[0];
+        assert_eq!((a.name.as_str(), a.frames), ("a", 5));
+        let t = a.time.unwrap();
+        assert_eq!(
+            [t.median_ns, t.min_ns, t.max_ns, t.p90_ns],
+            [30.0, 10.0, 50.0, 50.0]
+        );
+        assert_eq!(r.frame_span.time.unwrap().median_ns, 50.0);
+        assert_eq!(r.median.as_ref().unwrap().pass_ns("a"), Some(30.0));
+        assert_eq!(r.clock, "host-fence");
+        let table = r.table();
+        assert!(
+            table.contains("p90") && table.contains("frame (GPU span)"),
+            "{table}"
+        );
+    }
+
+    #[test]
+    fn json_holds_the_setup_and_flat_statistics() {
+        let v = serde_json::to_value(report(&[7.0, 3.0, 5.0])).unwrap();
+        assert_eq!(v["setup"]["irradiance_resolution"], 256);
+        assert_eq!(v["setup"]["kernel"], "deon7");
+        assert_eq!(v["dermis_version"], VERSION);
+        assert!(v["git_commit"].as_str().is_some_and(|c| !c.is_empty()));
+        assert_eq!(v["passes"][0]["frames"], 2);
+        assert_eq!(v["passes"][0]["median_ns"], 4.0);
+        assert_eq!(v["passes"][1]["p90_ns"], 5.0);
+        assert_eq!(v["per_frame"][1]["passes"][1]["start_ns"], 13.0);
+    }
+
+    #[test]
+    fn a_pass_no_frame_timed_has_a_count_of_zero() {
+        let mut f = frames(&[1.0]);
+        f[0].passes[0].gpu_ns = None;
+        let r = RunReport::new(&device(), setup(), 1, 1, f, MemoryUse::default());
+        let v = serde_json::to_value(&r.passes[0]).unwrap();
+        assert_eq!(v["frames"], 0);
+        assert!(v.get("median_ns").is_none(), "{v}");
+    }
+}

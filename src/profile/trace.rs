@@ -1,0 +1,202 @@
+//! `--trace FILE.json`: the run as Chrome trace events (Perfetto, chrome://tracing).
+//! One track per clock; on it a slice for the run, one per frame at the frame's
+//! start, and one per pass at frame start + the pass's start offset, so passes
+//! nest in their frame and frames in the run.
+
+use super::run::RunReport;
+use serde_json::{json, Value};
+
+const PID: u32 = 1;
+
+/// `ts` and `dur` in µs of a slice from `begin` to `end` ns, both rounded to whole
+/// ns first: a pass that ends with its frame keeps ending with it (no nesting
+/// broken by float sums), and readers that convert back to ns land on integers.
+fn ts_dur(begin_ns: f64, end_ns: f64) -> (f64, f64) {
+    let (b, e) = (begin_ns.round(), end_ns.round());
+    (b / 1e3, (e.max(b) - b) / 1e3)
+}
+
+/// The trace as a JSON value (`{"traceEvents": [...], "displayTimeUnit": "ns"}`).
+pub fn trace(report: &RunReport) -> Value {
+    let mut clocks: Vec<&str> = Vec::new();
+    for f in &report.per_frame {
+        if !clocks.contains(&f.clock.as_str()) {
+            clocks.push(&f.clock);
+        }
+    }
+    let tid = |clock: &str| clocks.iter().position(|c| *c == clock).unwrap_or(0) + 1;
+    let mut events = vec![json!({
+        "name": "process_name", "ph": "M", "pid": PID, "tid": 0,
+        "args": { "name": format!("dermis {} ({}) on {}", report.dermis_version, report.git_commit, report.device) },
+    })];
+    for c in &clocks {
+        let name = match *c {
+            "gpu-timestamp" => "queue 0: GPU timestamps".to_string(),
+            "host-fence" => "queue 0: host clock, submit to fence per pass".to_string(),
+            other => format!("queue 0: {other}"),
+        };
+        events.push(json!({
+            "name": "thread_name", "ph": "M", "pid": PID, "tid": tid(c),
+            "args": { "name": name },
+        }));
+    }
+    // Frames without a start (no timestamps) follow the previous one.
+    let mut slices = Vec::new();
+    let mut cursor = 0.0f64;
+    let mut run_end = 0.0f64;
+    for f in &report.per_frame {
+        let start = f.start_ns.unwrap_or(cursor);
+        let pass_end = f
+            .passes
+            .iter()
+            .filter_map(|p| Some(p.start_ns? + p.gpu_ns?))
+            .fold(0.0, f64::max);
+        let span = f.gpu_frame_ns.unwrap_or(pass_end);
+        cursor = start + span;
+        run_end = run_end.max(cursor);
+        let warmup = (f.frame as usize) < report.warmup_frames;
+        let (ts, dur) = ts_dur(start, start + span);
+        slices.push(json!({
+            "name": format!("frame {}", f.frame), "cat": "frame", "ph": "X",
+            "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur,
+            "args": {
+                "frame": f.frame, "warmup": warmup,
+                "cpu_record_ns": f.cpu_record_ns, "cpu_submit_ns": f.cpu_submit_ns,
+            },
+        }));
+        for p in &f.passes {
+            let (Some(offset), Some(dur)) = (p.start_ns, p.gpu_ns) else {
+                continue;
+            };
+            let (ts, dur_us) = ts_dur(start + offset, start + offset + dur);
+            slices.push(json!({
+                "name": p.name, "cat": "pass", "ph": "X",
+                "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur_us,
+                "args": { "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur },
+            }));
+        }
+    }
+    if let Some(first) = report.per_frame.first() {
+        let s = &report.setup;
+        events.push(json!({
+            "name": "run", "cat": "run", "ph": "X", "pid": PID, "tid": tid(&first.clock),
+            "ts": 0.0, "dur": ts_dur(0.0, run_end).1,
+            "args": {
+                "dermis_version": report.dermis_version, "git_commit": report.git_commit,
+                "device": report.device, "driver": report.driver, "clock": report.clock,
+                "scene": s.scene, "mesh": s.mesh, "environment": s.environment,
+                "irradiance_resolution": s.irradiance_resolution, "kernel": s.kernel,
+                "chain": s.chain, "view": s.view, "occlusion": s.occlusion,
+                "width": report.width, "height": report.height, "frames": report.frames,
+            },
+        }));
+    }
+    events.extend(slices);
+    json!({ "traceEvents": events, "displayTimeUnit": "ns" })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::run::tests::report;
+    use super::*;
+
+    fn slices<'a>(t: &'a Value, cat: &str) -> Vec<&'a Value> {
+        t["traceEvents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e["cat"] == cat)
+            .collect()
+    }
+
+    const EPS: f64 = 1e-9;
+
+    fn span(e: &Value) -> (f64, f64) {
+        let ts = e["ts"].as_f64().unwrap();
+        (ts, ts + e["dur"].as_f64().unwrap())
+    }
+
+    #[test]
+    fn passes_nest_in_their_frame_without_overlap() {
+        let text = serde_json::to_string(&trace(&report(&[30.0, 10.0, 20.0]))).unwrap();
+        let t: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(t["displayTimeUnit"], "ns");
+        let frames = slices(&t, "frame");
+        let passes = slices(&t, "pass");
+        assert_eq!((frames.len(), passes.len()), (3, 6));
+        for e in frames.iter().chain(&passes) {
+            assert_eq!(e["ph"], "X");
+            assert_eq!(e["pid"], 1);
+            assert_eq!(e["tid"], 1);
+        }
+        for f in &frames {
+            let (f0, f1) = span(f);
+            let mut mine: Vec<(f64, f64)> = passes
+                .iter()
+                .filter(|p| p["args"]["frame"] == f["args"]["frame"])
+                .map(|p| span(p))
+                .collect();
+            assert_eq!(mine.len(), 2);
+            mine.sort_by(|a, b| a.0.total_cmp(&b.0));
+            // µs floats: allow rounding at the 1e-9 µs level.
+            for (p0, p1) in &mine {
+                assert!(
+                    f0 <= *p0 && *p1 <= f1 + EPS,
+                    "{p0}..{p1} outside {f0}..{f1}"
+                );
+            }
+            assert!(mine[0].1 <= mine[1].0 + EPS, "passes overlap: {mine:?}");
+        }
+        // Frame 1 starts at 1000 ns = 1 µs, lasts 30 ns; its pass "a" at +10 ns.
+        let (f0, f1) = span(frames[1]);
+        assert!(f0 == 1.0 && (f1 - 1.03).abs() < EPS, "{f0}..{f1}");
+        assert_eq!(passes[2]["name"], "a");
+        assert_eq!(span(passes[2]).0, 1.01);
+        let run = slices(&t, "run");
+        assert_eq!(run[0]["args"]["irradiance_resolution"], 256);
+        assert_eq!(span(run[0]), (0.0, 2.04));
+        let names: Vec<_> = t["traceEvents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e["ph"] == "M")
+            .map(|e| e["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(names, ["process_name", "thread_name"]);
+    }
+
+    #[test]
+    fn fractional_ns_keep_a_pass_that_ends_with_its_frame_inside_it() {
+        // Timestamp periods make fractional ns; the last pass ends with the frame.
+        let mut r = report(&[30.0]);
+        let f = &mut r.per_frame[0];
+        f.start_ns = Some(1000.6);
+        f.gpu_frame_ns = Some(10.3);
+        f.passes[1].start_ns = Some(5.1);
+        f.passes[1].gpu_ns = Some(5.2);
+        f.passes.truncate(2);
+        let t = trace(&r);
+        let (frame, pass) = (slices(&t, "frame")[0], slices(&t, "pass")[1]);
+        // Whole ns: frame 1001..1011, pass 1006..1011.
+        assert_eq!(
+            (frame["ts"].as_f64(), frame["dur"].as_f64()),
+            (Some(1.001), Some(0.01))
+        );
+        assert_eq!(
+            (pass["ts"].as_f64(), pass["dur"].as_f64()),
+            (Some(1.006), Some(0.005))
+        );
+    }
+
+    #[test]
+    fn frames_without_a_start_follow_each_other() {
+        let mut r = report(&[30.0, 10.0]);
+        for f in &mut r.per_frame {
+            f.start_ns = None;
+        }
+        let t = trace(&r);
+        let frames = slices(&t, "frame");
+        assert_eq!(span(frames[0]), (0.0, 0.05));
+        assert_eq!(span(frames[1]).0, 0.05);
+    }
+}
