@@ -9,18 +9,32 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// Environment variables and exit codes, shown by every command's `--help`.
+const AFTER_HELP: &str = "\
+Environment:
+  DERMIS_DEVICE=SUBSTRING   device to use (as --device)
+  DERMIS_VALIDATION=1       Khronos validation + synchronization validation (as --validation)
+  DERMIS_CACHE_DIR=DIR      occlusion transfer cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
+  RUST_LOG=LEVEL            log filter (overrides -v)
+  LP_NUM_THREADS=N          lavapipe's rasterizer threads (recorded in reports)
+
+Exit status:
+  0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver).";
+
 #[derive(Parser)]
 #[command(
     name = "dermis",
     version,
-    about = "Realistic face rendering on Vulkan, measured pass by pass"
+    about = "Realistic face rendering on Vulkan, measured pass by pass",
+    after_help = AFTER_HELP,
+    subcommand_help_heading = "Commands"
 )]
 struct Cli {
     /// Use the first Vulkan device whose name contains this (case-insensitive).
     #[arg(long, global = true, env = "DERMIS_DEVICE")]
     device: Option<String>,
     /// Enable the Khronos validation layer with synchronization validation.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, env = "DERMIS_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
     /// More log output (-v info, -vv debug); RUST_LOG overrides.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
@@ -32,12 +46,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Describe the Vulkan device dermis would use.
+    #[command(after_help = AFTER_HELP)]
     Info {
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
     },
     /// Print an environment's 27 SH coefficients (9 per channel), projected on the GPU.
+    #[command(after_help = AFTER_HELP)]
     Sh {
         /// A .hdr/.exr file, a cross, `cube:...`, `uniform:R,G,B` or `sky[:...]`.
         env: String,
@@ -52,6 +68,7 @@ enum Command {
         timings: bool,
     },
     /// Compute (and cache) the per-vertex occlusion transfer ahead of rendering.
+    #[command(after_help = AFTER_HELP)]
     Precompute {
         /// Scene file (its mesh and `skin.occlusion` are used), or `builtin`;
         /// default: assets/default.toml.
@@ -60,13 +77,15 @@ enum Command {
         /// glTF mesh, replacing the scene's.
         #[arg(long)]
         mesh: Option<PathBuf>,
+        /// Millimetres per mesh unit (e.g. 50.3 for the Lee Perry-Smith scan).
         #[arg(long)]
         mm_per_unit: Option<f32>,
-        /// raster (the paper's cube maps), raytrace (default) or off.
-        #[arg(long, value_parser = parse_occlusion)]
+        /// How visibility is computed (default: the scene's, raytrace).
+        #[arg(long, value_enum)]
         occlusion: Option<Occlusion>,
     },
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
+    #[command(after_help = AFTER_HELP)]
     Render {
         /// Scene file (docs/scene-format.md), or `builtin` for the built-in
         /// procedural head under the sky; default: assets/default.toml.
@@ -94,21 +113,23 @@ enum Command {
         /// Side of the UV-space irradiance texture (power of two, 256..8192).
         #[arg(long)]
         irradiance_res: Option<u32>,
-        /// Per-vertex occlusion: raster (the paper's cube maps), raytrace, off.
-        #[arg(long, value_parser = parse_occlusion)]
+        /// Per-vertex occlusion (default: the scene's, raytrace).
+        #[arg(long, value_enum)]
         occlusion: Option<Occlusion>,
-        /// The maps' UV origin: top-left (glTF) or bottom-left (OpenGL; flipped on load).
-        #[arg(long, value_parser = str::parse::<UvOrigin>)]
+        /// The maps' UV origin, replacing the scene's (bottom-left: flipped on load).
+        #[arg(long, value_enum)]
         uv_origin: Option<UvOrigin>,
+        /// Output width in pixels, replacing the scene's.
         #[arg(long)]
         width: Option<u32>,
+        /// Output height in pixels, replacing the scene's.
         #[arg(long)]
         height: Option<u32>,
-        /// What to write: final, diffuse, specular, direct, occlusion, irradiance,
-        /// stretch, blur1..blur6, prefiltered.
-        #[arg(long, default_value = "final")]
-        view: String,
-        /// Frames to render; with more than one the first is warm-up.
+        /// What to write: the final image or an intermediate (UV-space views at
+        /// the irradiance resolution, as stored).
+        #[arg(long, value_enum, default_value = "final")]
+        view: View,
+        /// Frames to render (≥ 1); with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
         /// Print the per-pass GPU time table (median, min, max, p90 of measured frames).
@@ -128,15 +149,6 @@ enum Command {
         #[arg(long)]
         dump_graph: bool,
     },
-}
-
-fn parse_occlusion(s: &str) -> Result<Occlusion, String> {
-    match s {
-        "raster" => Ok(Occlusion::Raster),
-        "raytrace" => Ok(Occlusion::Raytrace),
-        "off" => Ok(Occlusion::Off),
-        _ => Err(format!("{s:?}: expected raster, raytrace or off")),
-    }
 }
 
 fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String> {
@@ -307,7 +319,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 scene: overrides.apply(file)?,
                 frames,
                 hdr,
-                view: View::parse(&view)?,
+                view,
                 context,
                 scene_path: Some(scene.unwrap_or_else(default_scene_path)),
                 progress: std::io::stderr().is_terminal(),

@@ -509,3 +509,46 @@ fn precompute_fills_the_cache_and_reports_time() {
 fn zero_frames_is_a_clean_input_error() {
     assert_bad_input(&["--frames", "0", "--irradiance-res", "256"], "0 frames");
 }
+
+#[test]
+fn help_documents_every_flag_the_environment_and_exit_codes() {
+    for command in ["info", "sh", "precompute", "render"] {
+        let out = dermis(&[command, "--help"]);
+        assert!(out.status.success(), "{command} --help");
+        let help = String::from_utf8_lossy(&out.stdout).to_string();
+        let lines: Vec<&str> = help.lines().collect();
+        let mut flags = 0;
+        for (i, line) in lines.iter().enumerate() {
+            let t = line.trim_start();
+            if !(t.starts_with("--")
+                || (t.starts_with('-') && t.chars().nth(1).is_some_and(char::is_alphabetic)))
+            {
+                continue;
+            }
+            flags += 1;
+            // Short help puts the description on the flag's line after two spaces,
+            // long help on the lines after it.
+            let doc = match t.split_once("  ") {
+                Some((_, rest)) if !rest.trim().is_empty() => rest.trim(),
+                _ => lines.get(i + 1).map_or("", |l| l.trim()),
+            };
+            assert!(!doc.is_empty(), "{command}: {t:?} has no help text\n{help}");
+        }
+        assert!(flags >= 4, "{command}: only {flags} flags found\n{help}");
+        for needle in [
+            "DERMIS_DEVICE",
+            "DERMIS_VALIDATION",
+            "DERMIS_CACHE_DIR",
+            "RUST_LOG",
+            "Exit status",
+            "2 bad input",
+        ] {
+            assert!(help.contains(needle), "{command} --help lacks {needle}");
+        }
+    }
+    // Value lists come from the enums.
+    let help = String::from_utf8_lossy(&dermis(&["render", "--help"]).stdout).to_string();
+    for value in ["blur6", "prefiltered", "raytrace", "bottom-left"] {
+        assert!(help.contains(value), "render --help lacks {value}");
+    }
+}
