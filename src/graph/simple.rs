@@ -5,7 +5,7 @@
 //! from the SPIR-V when the graph compiles, so binding order is written in GLSL and
 //! in exactly one Rust call chain.
 //!
-//! ```ignore
+//! ```text
 //! g.simple_pass("blur1_u", &pipeline)
 //!     .sample(&src, &sampler)          // binding 0
 //!     .store(&mut dst)                 // binding 1

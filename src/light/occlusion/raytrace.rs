@@ -508,29 +508,4 @@ mod tests {
             },
         );
     }
-
-    /// Full default settings (and the offset's effect); run with
-    /// `cargo test --release --lib light::occlusion -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn lee_perry_smith_default_timing() {
-        let m = lee_perry_smith();
-        check_head(&m, &RayOptions::default());
-        for offset_mm in [0.01, 1.0] {
-            check_head(
-                &m,
-                &RayOptions {
-                    offset_mm,
-                    ..RayOptions::default()
-                },
-            );
-        }
-        check_head(
-            &m,
-            &RayOptions {
-                samples: 1024,
-                ..RayOptions::default()
-            },
-        );
-    }
 }
