@@ -451,15 +451,6 @@ mod tests {
         crate::assets::dir()
     }
 
-    const MAPS: [&str; 6] = [
-        "studio.exr",
-        "sunset.exr",
-        "royal_esplanade_1k.hdr",
-        "venice_sunset_1k.hdr",
-        "pedestrian_overpass_1k.hdr",
-        "quarry_01_1k.hdr",
-    ];
-
     /// Maps whose light is spread out (sky, no visible sun disk). The brief's
     /// bound (mean per-normal relative error < 3 %) is asserted on these.
     /// The other four have a compact dominant source (sun: pedestrian_overpass,
@@ -500,7 +491,7 @@ mod tests {
             bound_max * 100.0
         );
         let mut failures = Vec::new();
-        for name in MAPS {
+        for name in crate::assets::ENV_MAPS {
             let (env, _) = load(&dir.join("env").join(name)).unwrap();
             let t = std::time::Instant::now();
             let l = project(&env);

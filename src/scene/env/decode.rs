@@ -458,14 +458,7 @@ mod tests {
     #[test]
     fn load_real_maps() {
         let dir = assets();
-        for name in [
-            "studio.exr",
-            "sunset.exr",
-            "royal_esplanade_1k.hdr",
-            "venice_sunset_1k.hdr",
-            "pedestrian_overpass_1k.hdr",
-            "quarry_01_1k.hdr",
-        ] {
+        for name in crate::assets::ENV_MAPS {
             let t = std::time::Instant::now();
             let (env, r) = load(&dir.join("env").join(name)).unwrap();
             assert_eq!((env.width, env.height), (1024, 512), "{name}");
