@@ -3,7 +3,9 @@
 //! one dispatch or draw. Accesses follow from the pipeline (compute or fragment)
 //! and the declaration; the declaration is checked against the layout reflected
 //! from the SPIR-V when the graph compiles, so binding order is written in GLSL and
-//! in exactly one Rust call chain.
+//! in exactly one Rust call chain. A binding the shader leaves unused (a gap in its
+//! layout, e.g. one declaration shared by two fragment shaders) is tracked by the
+//! graph but not written.
 //!
 //! ```text
 //! g.simple_pass("blur1_u", &pipeline)
