@@ -1,5 +1,5 @@
-//! Per-pass GPU cost of the default frame (built-in head under the sky, 1280×720)
-//! against the irradiance (blur) resolution: medians over warmed-up frames (the
+//! Per-pass GPU cost of the built-in head's frame (`--scene builtin`: under the sky,
+//! 1280×720) against the irradiance (blur) resolution: medians over warmed-up frames (the
 //! first frame of each resolution is warm-up: lavapipe compiles shaders on first
 //! use). `cargo bench --bench frame`; `DERMIS_BENCH_FRAMES` (default 4),
 //! `DERMIS_BENCH_SIZES` (irradiance sides, default "512,1024,2048,4096") and
