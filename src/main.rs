@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{default_scene_path, scene_by_name, Occlusion, UvOrigin};
+use dermis::scene::file::{default_scene_path, scene_by_name, Chain, Kernel, Occlusion, UvOrigin};
 use dermis::scene::Overrides;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -116,6 +116,14 @@ enum Command {
         /// Per-vertex occlusion (default: the scene's, raytrace).
         #[arg(long, value_enum)]
         occlusion: Option<Occlusion>,
+        /// Blur kernel of the diffusion chain, replacing the scene's `skin.kernel`.
+        #[arg(long, value_enum)]
+        kernel: Option<Kernel>,
+        /// Resolutions of the diffusion chain, replacing the scene's `skin.chain`:
+        /// `full` blurs every level at the irradiance resolution, `adaptive` each at
+        /// the coarsest resolution its Gaussian allows.
+        #[arg(long, value_enum)]
+        chain: Option<Chain>,
         /// The maps' UV origin, replacing the scene's (bottom-left: flipped on load).
         #[arg(long, value_enum)]
         uv_origin: Option<UvOrigin>,
@@ -289,6 +297,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
             exposure,
             irradiance_res,
             occlusion,
+            kernel,
+            chain,
             uv_origin,
             width,
             height,
@@ -309,6 +319,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 exposure,
                 irradiance_resolution: irradiance_res,
                 occlusion,
+                kernel,
+                chain,
                 uv_origin,
                 width,
                 height,

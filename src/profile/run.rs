@@ -24,7 +24,7 @@ pub struct RunSetup {
     pub irradiance_resolution: u32,
     /// Blur kernel: `deon7` or `accurate`.
     pub kernel: String,
-    /// Which passes the diffusion chain runs (today always `full`).
+    /// Resolutions of the diffusion chain: `full` or `adaptive`.
     pub chain: String,
     /// `final` or the intermediate written.
     pub view: String,

@@ -15,7 +15,7 @@ use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph};
 use crate::post::tonemap::encode8;
 use crate::profile::{MemoryUse, RunReport, RunSetup};
-use crate::scene::file::{Kernel, Occlusion, SceneFile};
+use crate::scene::file::{Chain, Kernel, Occlusion, SceneFile};
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
 use frame::Frame;
@@ -54,9 +54,6 @@ impl Default for RenderOptions {
     }
 }
 
-/// The diffusion chain's variant; one today.
-const CHAIN: &str = "full";
-
 /// What the report says was rendered.
 fn setup(scene: &Scene, opts: &RenderOptions, irradiance_resolution: u32) -> RunSetup {
     let f = &scene.file;
@@ -75,7 +72,11 @@ fn setup(scene: &Scene, opts: &RenderOptions, irradiance_resolution: u32) -> Run
             Kernel::Accurate => "accurate",
         }
         .into(),
-        chain: CHAIN.into(),
+        chain: match f.skin.chain {
+            Chain::Full => "full",
+            Chain::Adaptive => "adaptive",
+        }
+        .into(),
         view: opts.view.name().into(),
         render_width: f.render.width,
         render_height: f.render.height,

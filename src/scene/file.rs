@@ -294,13 +294,23 @@ fn yes() -> bool {
 }
 
 /// Blur kernel for the Gaussian chain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Kernel {
     /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in ARCHITECTURE.md).
     Deon7,
     /// Wider, exactly normalised Gaussian taps (reference quality).
     Accurate,
+}
+
+/// At which resolutions the six Gaussians of the diffusion chain are blurred.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Chain {
+    /// Every level at `render.irradiance_resolution` (GPU Gems 3 §14.5).
+    Full,
+    /// Each level at the coarsest resolution its width allows (skin::chain).
+    Adaptive,
 }
 
 /// How the per-vertex SH transfer's visibility is computed.
@@ -348,6 +358,7 @@ pub struct Skin {
     /// (pre-/post-scatter texturing, GPU Gems 3 §14.5).
     pub mix: f32,
     pub kernel: Kernel,
+    pub chain: Chain,
     /// Sum-of-Gaussians profile, variances strictly increasing; `None`: the
     /// skin model's published six-Gaussian profile (skin::profile).
     pub profile: Option<Vec<ProfileGaussian>>,
@@ -365,6 +376,7 @@ impl Default for Skin {
         Skin {
             mix: 0.5,
             kernel: Kernel::Deon7,
+            chain: Chain::Full,
             profile: None,
             regions: None,
             occlusion: Occlusion::Raytrace,

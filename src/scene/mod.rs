@@ -36,6 +36,8 @@ pub struct Overrides {
     pub exposure: Option<f32>,
     pub irradiance_resolution: Option<u32>,
     pub occlusion: Option<Occlusion>,
+    pub kernel: Option<file::Kernel>,
+    pub chain: Option<file::Chain>,
     /// `--uv-origin`: replaces `textures.uv_origin`.
     pub uv_origin: Option<UvOrigin>,
     pub width: Option<u32>,
@@ -66,6 +68,8 @@ impl Overrides {
             .irradiance_resolution
             .unwrap_or(file.render.irradiance_resolution);
         file.skin.occlusion = self.occlusion.unwrap_or(file.skin.occlusion);
+        file.skin.kernel = self.kernel.unwrap_or(file.skin.kernel);
+        file.skin.chain = self.chain.unwrap_or(file.skin.chain);
         file.textures.uv_origin = self.uv_origin.unwrap_or(file.textures.uv_origin);
         file.render.width = self.width.unwrap_or(file.render.width);
         file.render.height = self.height.unwrap_or(file.render.height);
