@@ -10,7 +10,7 @@ layout(binding = 1) uniform sampler2D albedo_tex;   // sRGB format: sampled line
 layout(binding = 2) uniform sampler2D normal_tex;   // tangent space, [0,1] encoded
 // SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
 // (rgb), rotated and scaled by the environment intensity.
-layout(std430, binding = 3) readonly buffer Lighting { vec4 sh[9]; } lighting;
+layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;

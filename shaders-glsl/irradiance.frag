@@ -7,10 +7,10 @@
 #include "sh.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
-layout(push_constant) uniform Push { float mix_pre; uint roughness_map; } pc;
+layout(push_constant) uniform Push { float mix_pre; } pc;
 // SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
 // (rgb), rotated and scaled by the environment intensity.
-layout(std430, binding = 3) readonly buffer Lighting { vec4 sh[9]; } lighting;
+layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -34,7 +34,7 @@ layout(location = 0) out vec4 irradiance;
 
 void main() {
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-    vec3 e = irradiance_at(v_position, v_normal, n, specular_params(v_uv, pc.roughness_map != 0u));
+    vec3 e = irradiance_at(v_position, v_normal, n, specular_params(v_uv));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
 }

@@ -30,7 +30,7 @@ layout(binding = 11) uniform sampler2D blur6;
 #include "normal_map.glsl"
 #include "visibility.glsl"
 // mode: 0 final, 1 diffuse only, 2 specular only.
-layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; uint roughness_map; } pc;
+layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; } pc;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -52,21 +52,21 @@ void main() {
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.
     if (dot(v_normal, v) < 0.0) n = -n;
-    vec2 params = specular_params(v_uv, pc.roughness_map != 0u);
+    vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     // Light leaving the skin loses what the oil layer reflects toward the viewer.
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI
              * diffuse_transmission(n_dot_v, params);
     vec3 spec = vec3(0.0);
-    for (int i = 0; i < int(frame.env.z); ++i) {
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e = light_irradiance(i, v_position, v_normal, l);
         spec += e * ks_specular(n, l, v, params);
     }
     // The environment's share, occluded like the diffuse by the vertex's
     // visibility (1 without occlusion).
-    float visibility = frame.env.w > 0.5 ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
+    float visibility = OCCLUSION ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
     spec += params.x * specular_albedo(n_dot_v, params.y)
           * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);

@@ -51,6 +51,7 @@ impl TestScene {
                     depth_format: None,
                     vertex_layout: None,
                     cull_mode: vk::CullModeFlags::NONE,
+                    specialization: &[],
                 },
             )
         };

@@ -6,6 +6,12 @@ layout(std140, binding = 0) uniform Frame {
     vec4 light_vec[4];      // w 0: xyz direction towards the light; w 1: xyz position, mm
     vec4 light_color[4];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
     mat4 light_shadow[4];   // world → (atlas u, v, depth) after the divide by w
-    vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on
+    vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
     vec4 params;            // x: exposure (EV)
 } frame;
+// Fixed for a render (frame::ShaderVariant): the driver unrolls the light loop and
+// drops dead branches, which a CPU driver would otherwise run with masked lanes.
+layout(constant_id = 0) const int LIGHT_COUNT = 0;
+layout(constant_id = 1) const bool OCCLUSION = true;
+layout(constant_id = 2) const bool ROUGHNESS_MAP = false;
+layout(constant_id = 3) const int SHADOWED_LIGHTS = 0;   // bit i: light i has a shadow map

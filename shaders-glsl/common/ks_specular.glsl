@@ -5,15 +5,15 @@
 //   SPEC_ALBEDO    sampler2D  A(cos θ, m), skin/specular.rs::specular_albedo_lut
 //   SPEC_REGIONS   sampler2D  region id in R (texel = id / 255)
 //   SPEC_INTENSITY sampler2D  ρs scale (the specular map)
-//   SPEC_ROUGHNESS sampler2D  m (grey), used when roughness_map != 0
-//   SPEC_PARAMS    buffer     per region (ρs, m)
+//   SPEC_ROUGHNESS sampler2D  m (grey), used when ROUGHNESS_MAP (frame.glsl)
+//   SPEC_PARAMS    uniform    per region (ρs, m)
 #include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
 layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
 layout(binding = SPEC_REGIONS) uniform sampler2D region_tex;
 layout(binding = SPEC_INTENSITY) uniform sampler2D intensity_tex;
 layout(binding = SPEC_ROUGHNESS) uniform sampler2D roughness_tex;
-layout(std430, binding = SPEC_PARAMS) readonly buffer RegionParams { vec4 region_params[10]; };
+layout(std140, binding = SPEC_PARAMS) uniform RegionParams { vec4 region_params[10]; };
 
 // Endpoint-inclusive tables (skin/specular.rs::table_point): x = i/(n−1) at texel i.
 vec2 table_uv(sampler2D table, vec2 x) {
@@ -25,7 +25,7 @@ const float REGION_BLEND_TEXELS = 4.0;   // region borders blend over ±8 texels
 
 // (ρs, m) at uv: region parameters blended with tent weights over a 3×3 grid of
 // region-map texels REGION_BLEND_TEXELS apart, so borders are soft, not hard edges.
-vec2 specular_params(vec2 uv, bool roughness_map) {
+vec2 specular_params(vec2 uv) {
     ivec2 size = textureSize(region_tex, 0);
     vec2 acc = vec2(0.0);
     float total = 0.0;
@@ -41,7 +41,7 @@ vec2 specular_params(vec2 uv, bool roughness_map) {
     }
     vec2 params = acc / total;
     params.x *= texture(intensity_tex, uv).r;
-    if (roughness_map) params.y = texture(roughness_tex, uv).r;
+    if (ROUGHNESS_MAP) params.y = texture(roughness_tex, uv).r;
     params.y = clamp(params.y, 0.02, 1.0);
     return params;
 }

@@ -7,16 +7,17 @@
 // 1 − ρs·A(N·L, m): what the specular reflects does not enter the skin.
 vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
     vec3 e;
-    if (frame.env.w > 0.5) {
-        float t[9] = float[9](v_t012.x, v_t012.y, v_t012.z, v_t345.x, v_t345.y, v_t345.z,
-                              v_t678.x, v_t678.y, v_t678.z);
-        e = vec3(0.0);
-        for (int i = 0; i < 9; ++i) e += lighting.sh[i].rgb * t[i];
+    if (OCCLUSION) {
+        e = lighting.sh[0].rgb * v_t012.x + lighting.sh[1].rgb * v_t012.y
+          + lighting.sh[2].rgb * v_t012.z + lighting.sh[3].rgb * v_t345.x
+          + lighting.sh[4].rgb * v_t345.y + lighting.sh[5].rgb * v_t345.z
+          + lighting.sh[6].rgb * v_t678.x + lighting.sh[7].rgb * v_t678.y
+          + lighting.sh[8].rgb * v_t678.z;
     } else {
         e = sh_irradiance(lighting.sh, n);
     }
     e = max(e, vec3(0.0));
-    for (int i = 0; i < int(frame.env.z); ++i) {
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e_light = light_irradiance(i, x, ng, l);
         float n_dot_l = max(dot(n, l), 0.0);

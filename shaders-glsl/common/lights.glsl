@@ -44,6 +44,6 @@ vec3 light_irradiance(int i, vec3 x, vec3 ng, out vec3 l) {
     } else {
         l = lv.xyz;
     }
-    if (frame.light_color[i].w > 0.0) e *= shadow_visibility(i, x, ng, l, dist);
+    if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, l, dist);
     return e;
 }

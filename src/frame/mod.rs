@@ -13,7 +13,7 @@ pub use formats::{DEPTH_FORMAT, HDR_FORMAT, SHADOW_FORMAT};
 pub use mesh::{MeshBuffers, Vertex, VERTEX_ATTRIBUTES};
 pub use samplers::Samplers;
 pub use textures::{upload_env, upload_rgba8};
-pub use uniforms::{FrameUniforms, MAX_LIGHTS};
+pub use uniforms::{FrameUniforms, ShaderVariant, MAX_LIGHTS};
 
 use crate::gpu::{Buffer, Image, Sampler};
 use std::sync::Arc;
@@ -31,8 +31,8 @@ pub struct FrameInputs {
     pub specular: Arc<Image>,
     pub roughness: Arc<Image>,
     pub regions: Arc<Image>,
-    /// Whether the scene gave a roughness map (else the regions' m is used).
-    pub roughness_map: bool,
+    /// Lights, shadows, occlusion and maps the shading passes specialise on.
+    pub variant: ShaderVariant,
     pub env: Arc<Image>,
     /// Linear where the device filters RGBA32F, else nearest.
     pub env_sampler: Arc<Sampler>,

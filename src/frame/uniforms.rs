@@ -3,6 +3,34 @@
 /// Lights the frame's shaders loop over (common/lights.glsl).
 pub const MAX_LIGHTS: usize = 4;
 
+/// What stays fixed for a whole render and selects code in the shading passes:
+/// their specialization constants (shaders-glsl/common/frame.glsl). Fixed loop
+/// bounds and dead branches removed at pipeline creation matter on CPU drivers,
+/// which run both sides of every branch (docs/performance.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShaderVariant {
+    /// Explicit lights, ≤ MAX_LIGHTS.
+    pub lights: u32,
+    /// The per-vertex transfer carries visibility (else R&H at the shading normal).
+    pub occlusion: bool,
+    /// The scene gave a roughness map (else the regions' m is used).
+    pub roughness_map: bool,
+    /// Bit i: light i has a shadow map.
+    pub shadowed: u32,
+}
+
+impl ShaderVariant {
+    /// `constant_id` 0..=3 of frame.glsl.
+    pub fn specialization(&self) -> [u32; 4] {
+        [
+            self.lights,
+            u32::from(self.occlusion),
+            u32::from(self.roughness_map),
+            self.shadowed,
+        ]
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FrameUniforms {

@@ -16,6 +16,19 @@ pub struct GraphicsDesc<'a> {
     /// Vertex buffer stride and (format, offset) per location; `None`: no vertex input.
     pub vertex_layout: Option<(u32, &'a [(vk::Format, u32)])>,
     pub cull_mode: vk::CullModeFlags,
+    /// Specialization constants of both stages: `constant_id = i` takes `[i]`.
+    pub specialization: &'a [u32],
+}
+
+/// Map entries for specialization constants 0..n, one 32-bit word each.
+fn specialization_entries(values: &[u32]) -> Vec<vk::SpecializationMapEntry> {
+    (0..values.len() as u32)
+        .map(|i| vk::SpecializationMapEntry {
+            constant_id: i,
+            offset: 4 * i,
+            size: 4,
+        })
+        .collect()
 }
 
 pub struct Pipeline {
@@ -86,6 +99,16 @@ impl Pipeline {
 
     /// A compute pipeline; its layout is reflected from the shader.
     pub fn compute(ctx: &Arc<Context>, shader: &str) -> Result<Arc<Self>> {
+        Self::compute_specialized(ctx, shader, &[])
+    }
+
+    /// A compute pipeline whose `constant_id = i` takes `specialization[i]`
+    /// (fixed loop bounds and dead branches let the driver unroll and prune).
+    pub fn compute_specialized(
+        ctx: &Arc<Context>,
+        shader: &str,
+        specialization: &[u32],
+    ) -> Result<Arc<Self>> {
         let mut p = Self::with_layout(
             ctx,
             shader,
@@ -94,10 +117,15 @@ impl Pipeline {
             ShaderLayout::of(shader)?,
         )?;
         let module = ShaderModule::new(ctx, shader)?;
+        let entries = specialization_entries(specialization);
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(bytemuck::cast_slice(specialization));
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&spec);
         let info = vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(p.layout);
@@ -123,15 +151,21 @@ impl Pipeline {
         )?;
         let vs = ShaderModule::new(ctx, desc.vertex)?;
         let fs = ShaderModule::new(ctx, desc.fragment)?;
+        let entries = specialization_entries(desc.specialization);
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(bytemuck::cast_slice(desc.specialization));
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
                 .module(vs.raw)
-                .name(c"main"),
+                .name(c"main")
+                .specialization_info(&spec),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
                 .module(fs.raw)
-                .name(c"main"),
+                .name(c"main")
+                .specialization_info(&spec),
         ];
         let mut vertex_bindings = Vec::new();
         let mut vertex_attributes = Vec::new();

@@ -32,6 +32,8 @@ enum Bound {
     Texture(Arc<Image>, Arc<Sampler>),
     /// Graph storage buffer.
     Buffer(BufferRef),
+    /// Graph buffer read as a uniform buffer.
+    GraphUniform(BufferRef),
     /// Static uniform buffer outside the graph.
     Uniform(Arc<Buffer>),
     /// Static storage buffer outside the graph.
@@ -44,7 +46,7 @@ impl Bound {
             Bound::Storage(_) => vk::DescriptorType::STORAGE_IMAGE,
             Bound::Sampled(..) | Bound::Texture(..) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             Bound::Buffer(_) | Bound::StaticBuffer(_) => vk::DescriptorType::STORAGE_BUFFER,
-            Bound::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
+            Bound::Uniform(_) | Bound::GraphUniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
         }
     }
 
@@ -55,6 +57,7 @@ impl Bound {
             Bound::Texture(i, s) => Descriptor::StaticSampled(i, s),
             Bound::Buffer(r) => Descriptor::Storage(*r),
             Bound::Uniform(b) => Descriptor::StaticUniform(b),
+            Bound::GraphUniform(r) => Descriptor::Uniform(*r),
             Bound::StaticBuffer(b) => Descriptor::StaticStorage(b),
         }
     }
@@ -123,6 +126,14 @@ impl<'g> SimplePass<'g> {
         };
         let r = self.pass.read_buffer(buffer, access);
         self.bind(Bound::Buffer(r))
+    }
+
+    /// The next binding: a graph buffer read as a uniform buffer (it needs
+    /// UNIFORM_BUFFER usage). Uniform loads are much cheaper than storage loads on
+    /// CPU drivers (lavapipe: docs/performance.md).
+    pub fn read_uniform(mut self, buffer: &BufferHandle) -> Self {
+        let r = self.pass.read_buffer(buffer, Access::UniformRead);
+        self.bind(Bound::GraphUniform(r))
     }
 
     /// The next binding: a graph storage buffer, written (compute only).

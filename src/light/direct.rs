@@ -3,7 +3,7 @@
 //! plus the shadowed lights, for comparison with texture-space diffusion.
 
 use crate::error::Result;
-use crate::frame::{FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
@@ -24,7 +24,7 @@ pub struct DirectPass {
 }
 
 impl DirectPass {
-    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
         let lit = |fragment| {
             Pipeline::graphics(
                 ctx,
@@ -36,6 +36,7 @@ impl DirectPass {
                     vertex_layout: Some(Vertex::layout()),
                     // Scanned meshes are not reliably closed or consistently wound.
                     cull_mode: vk::CullModeFlags::NONE,
+                    specialization: &variant.specialization(),
                 },
             )
         };
@@ -68,7 +69,7 @@ impl DirectPass {
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
-            .read_buffer(sh)
+            .read_uniform(sh)
             .buffer(&inputs.transfer)
             .sample(shadows, &s.shadow)
             .color(hdr, LoadOp::Load)

@@ -74,7 +74,7 @@ impl ShBuffers {
             coefficients: storage(
                 "sh coefficients",
                 9 * 16,
-                vk::BufferUsageFlags::TRANSFER_SRC,
+                vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::UNIFORM_BUFFER,
             )?,
             rows,
         })

@@ -99,6 +99,7 @@ impl ShadowPass {
                 // Positions only.
                 vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
                 cull_mode: vk::CullModeFlags::NONE,
+                specialization: &[],
             },
         )?;
         Ok(Self { pipeline })

@@ -22,6 +22,7 @@ impl SkyboxPass {
                 depth_format: None,
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
+                specialization: &[],
             },
         )?;
         Ok(Self { pipeline })

@@ -63,6 +63,7 @@ impl Tonemap {
                 depth_format: None,
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
+                specialization: &[],
             },
         )?;
         Ok(Self { pipeline, sampler })

@@ -5,8 +5,8 @@
 use super::View;
 use crate::error::{Error, Result};
 use crate::frame::{
-    upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, HDR_FORMAT,
-    MAX_LIGHTS,
+    upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, ShaderVariant,
+    HDR_FORMAT, MAX_LIGHTS,
 };
 use crate::gpu::{Context, ImageDesc};
 use crate::graph::upload::upload_buffer;
@@ -166,7 +166,16 @@ impl Frame {
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
             roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
             regions: upload_rgba8(ctx, "region map", &scene.regions)?,
-            roughness_map: scene.file.textures.roughness.is_some(),
+            variant: ShaderVariant {
+                lights: scene.lights.len().min(MAX_LIGHTS) as u32,
+                occlusion: scene.file.skin.occlusion != Occlusion::Off,
+                roughness_map: scene.file.textures.roughness.is_some(),
+                shadowed: views
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| v.is_some())
+                    .fold(0, |bits, (i, _)| bits | 1 << i),
+            },
             env: upload_env(ctx, &scene.env)?,
             env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
                 samplers.linear.clone()
@@ -186,11 +195,11 @@ impl Frame {
         Ok(Self {
             tables,
             skybox: SkyboxPass::new(ctx)?,
-            direct: DirectPass::new(ctx)?,
+            direct: DirectPass::new(ctx, &inputs.variant)?,
             stretch: StretchPass::new(ctx)?,
-            irradiance: IrradiancePass::new(ctx)?,
+            irradiance: IrradiancePass::new(ctx, &inputs.variant)?,
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
-            shade: ShadePass::new(ctx)?,
+            shade: ShadePass::new(ctx, &inputs.variant)?,
             shadow: ShadowPass::new(ctx)?,
             shadow_views: views.into_iter().flatten().collect(),
             shadow_resolution: scene.file.render.shadow_resolution,
@@ -231,12 +240,9 @@ impl Frame {
         first: bool,
     ) -> (ImageHandle, Option<ImageHandle>) {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
-        let sh = self.sh.passes(
-            g,
-            &self.inputs.env,
-            &self.sh_buffers,
-            Access::FragmentBufferRead,
-        );
+        let sh = self
+            .sh
+            .passes(g, &self.inputs.env, &self.sh_buffers, Access::UniformRead);
         if view == View::Prefiltered {
             return (self.prefilter.pass(g, &self.inputs.env, first), None);
         }

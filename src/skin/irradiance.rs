@@ -4,7 +4,7 @@
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::FrameInputs;
+use crate::frame::{FrameInputs, ShaderVariant};
 use crate::gpu::{Context, ImageDesc, Pipeline};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use std::sync::Arc;
@@ -14,9 +14,14 @@ pub struct IrradiancePass {
 }
 
 impl IrradiancePass {
-    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
         Ok(Self {
-            pipeline: uv_pipeline(ctx, "uv_lit.vert", "irradiance.frag")?,
+            pipeline: uv_pipeline(
+                ctx,
+                "uv_lit.vert",
+                "irradiance.frag",
+                &variant.specialization(),
+            )?,
         })
     }
 
@@ -44,13 +49,13 @@ impl IrradiancePass {
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
-            .read_buffer(sh)
+            .read_uniform(sh)
             .buffer(&inputs.transfer);
         let pass = tables
             .bind(pass, inputs)
             .sample(shadows, &s.shadow)
             .color(&mut out, LoadOp::Clear([0.0; 4]))
-            .constants(&[mix.to_bits(), u32::from(inputs.roughness_map)]);
+            .constants(&mix);
         inputs.mesh.draw(pass);
         out
     }

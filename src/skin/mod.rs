@@ -113,6 +113,7 @@ pub(crate) fn uv_pipeline(
     ctx: &Arc<Context>,
     vertex: &str,
     fragment: &str,
+    specialization: &[u32],
 ) -> Result<Arc<Pipeline>> {
     Pipeline::graphics(
         ctx,
@@ -124,6 +125,7 @@ pub(crate) fn uv_pipeline(
             vertex_layout: Some(Vertex::layout()),
             // UV charts may be mirrored: both windings are surface.
             cull_mode: vk::CullModeFlags::NONE,
+            specialization,
         },
     )
 }

@@ -4,7 +4,7 @@
 
 use super::tables::SpecularTables;
 use crate::error::Result;
-use crate::frame::{FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use ash::vk;
@@ -16,7 +16,6 @@ struct ShadePush {
     weights: [[f32; 4]; 6],
     mix_pre: f32,
     mode: u32,
-    roughness_map: u32,
 }
 
 /// The profile weights, albedo split and output of the final pass.
@@ -53,7 +52,7 @@ pub struct ShadePass {
 }
 
 impl ShadePass {
-    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -63,6 +62,7 @@ impl ShadePass {
                 depth_format: Some(DEPTH_FORMAT),
                 vertex_layout: Some(Vertex::layout()),
                 cull_mode: vk::CullModeFlags::NONE,
+                specialization: &variant.specialization(),
             },
         )?;
         Ok(Self { pipeline })
@@ -102,7 +102,6 @@ impl ShadePass {
                 weights: settings.weights.map(|w| w.extend(0.0).into()),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
-                roughness_map: u32::from(inputs.roughness_map),
             });
         inputs.mesh.draw(pass);
     }

@@ -16,7 +16,7 @@ pub struct StretchPass {
 impl StretchPass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
         Ok(Self {
-            pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag")?,
+            pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag", &[])?,
         })
     }
 

@@ -78,7 +78,7 @@ impl SpecularTables {
                 ctx,
                 "region parameters",
                 bytemuck::cast_slice(&params),
-                Access::ShaderBufferRead,
+                Access::UniformRead,
             )?,
             sampler: if ctx.supports_linear_filter(vk::Format::R32_SFLOAT) {
                 linear
@@ -98,6 +98,6 @@ impl SpecularTables {
             .texture(&inputs.regions, &s.nearest)
             .texture(&inputs.specular, &s.linear)
             .texture(&inputs.roughness, &s.linear)
-            .buffer(&self.regions)
+            .uniform(&self.regions)
     }
 }

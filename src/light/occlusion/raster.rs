@@ -126,6 +126,7 @@ pub fn raster_vertices(
             // Positions only.
             vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
             cull_mode: vk::CullModeFlags::NONE,
+            specialization: &[],
         },
     )?;
     let reduce = Pipeline::compute(ctx, "occlusion_reduce.comp")?;
