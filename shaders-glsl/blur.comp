@@ -1,57 +1,50 @@
 #version 460
-// One direction of one Gaussian of the skin chain (GPU Gems 3 §14.4.2-3), applied
-// to the irradiance and the stretch map with the same taps. Taps sit at
-// offset_σ · σ_mm · stretch texels (stretch in texels/mm, from the previous
-// stretch level) and are read with bilinear filtering. Both images are
-// coverage-premultiplied (alpha = coverage), so the chain is linear and the
-// final divide by alpha gives a convolution normalised over the mesh: gutter
-// texels never pull black into chart borders.
+// One direction of one Gaussian of the skin chain (GPU Gems 3 §14.4.2-3): the
+// destination texel's taps sit at offset_σ · σ_mm · stretch along the blur axis,
+// stretch (texels/mm) read from the stretch level before this one, and are read
+// with bilinear filtering in normalised coordinates, so the source may be finer
+// than the destination (the adaptive chain downsamples as it blurs; the Gaussian
+// is the low-pass). The same shader blurs the stretch chain (src = stretch).
+// Images are coverage-premultiplied (alpha = coverage), so the chain is linear
+// and the final divide by alpha gives a convolution normalised over the mesh:
+// gutter texels never pull black into chart borders.
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0) uniform sampler2D src_irradiance;
-layout(binding = 1) uniform sampler2D src_stretch;
-layout(binding = 2, rgba16f) uniform writeonly image2D dst_irradiance;
-layout(binding = 3, rgba16f) uniform writeonly image2D dst_stretch;
-layout(std430, binding = 4) readonly buffer Kernel { vec2 taps[]; };   // (offset in σ, weight)
-// tap_count > 0: the fixed kernel in `taps` (d'Eon's 7 taps at 1σ).
-// tap_count = 0: the accurate kernel: Gaussian weights at a spacing of at most
-// min(0.5σ, 0.5 texel) out to ±4σ, with σ² reduced by the 1/6 texel² that
-// bilinear taps add (the variance of the tent a linear filter convolves with).
-layout(push_constant) uniform Push { ivec2 dir; float sigma_mm; int tap_count; } pc;
+// > 0: the fixed kernel's tap count (d'Eon's 7 taps at 1σ); 0: the accurate kernel.
+layout(constant_id = 0) const int TAP_COUNT = 7;
+layout(binding = 0) uniform sampler2D src;
+layout(binding = 1) uniform sampler2D stretch;
+layout(binding = 2, rgba16f) uniform writeonly image2D dst;
+const int MAX_FIXED_TAPS = 32;   // skin/blur.rs::MAX_FIXED_TAPS
+layout(std140, binding = 3) uniform Kernel { vec4 taps[MAX_FIXED_TAPS]; };   // (offset in σ, weight)
+layout(push_constant) uniform Push { ivec2 dir; float sigma_mm; } pc;
 
+// The accurate kernel: Gaussian weights at a spacing of at most min(0.5σ,
+// 0.5 texel) out to ±4σ, with σ² reduced by the 1/6 texel² that linear
+// interpolation adds (the variance of the tent it convolves with).
 const float MAX_SPACING_SIGMA = 0.5;
 const float MAX_SPACING_TEXELS = 0.5;
 const float EXTENT_SIGMA = 4.0;
 const int MAX_TAPS = 257;
 
-// Linear interpolation along the blur axis: every tap lies on the line through
-// this texel's centre, so bilinear filtering reduces to a lerp of two texels.
-ivec2 clamp_texel(ivec2 t, ivec2 size) { return clamp(t, ivec2(0), size - 1); }
-
-void fetch(float offset, ivec2 p, ivec2 size, out vec4 irr, out vec4 str) {
-    float f = floor(offset);
-    float t = offset - f;
-    ivec2 a = clamp_texel(p + int(f) * pc.dir, size);
-    ivec2 b = clamp_texel(p + (int(f) + 1) * pc.dir, size);
-    irr = mix(texelFetch(src_irradiance, a, 0), texelFetch(src_irradiance, b, 0), t);
-    str = mix(texelFetch(src_stretch, a, 0), texelFetch(src_stretch, b, 0), t);
-}
-
 void main() {
-    ivec2 size = imageSize(dst_irradiance);
+    ivec2 size = imageSize(dst);
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, size))) return;
-    vec4 st = texelFetch(src_stretch, p, 0);
-    // Far out in the gutter there is no stretch to normalise: use 1 texel/mm.
-    vec2 s = st.a > 1e-4 ? st.rg / st.a : vec2(1.0);
-    float sigma_texels = pc.sigma_mm * (pc.dir.x != 0 ? s.x : s.y);
-    vec4 irr = vec4(0.0);
-    vec4 str = vec4(0.0);
-    vec4 ti, ts;
-    if (pc.tap_count > 0) {
-        for (int i = 0; i < pc.tap_count; ++i) {
-            fetch(taps[i].x * sigma_texels, p, size, ti, ts);
-            irr += taps[i].y * ti;
-            str += taps[i].y * ts;
+    vec2 uv = (vec2(p) + 0.5) / vec2(size);
+    vec2 src_size = vec2(textureSize(src, 0));
+    // Stretch in source texels per mm; far out in the gutter there is no
+    // stretch to normalise: one destination texel per mm.
+    vec4 st = textureLod(stretch, uv, 0.0);
+    vec2 s = st.a > 1e-4 ? st.rg / st.a * src_size / vec2(textureSize(stretch, 0))
+                         : src_size / vec2(size);
+    bool along_u = pc.dir.x != 0;
+    float sigma_texels = pc.sigma_mm * (along_u ? s.x : s.y);
+    // One source texel along the blur axis, in normalised coordinates.
+    vec2 texel = vec2(pc.dir) / src_size;
+    vec4 sum = vec4(0.0);
+    if (TAP_COUNT > 0) {
+        for (int i = 0; i < TAP_COUNT; ++i) {
+            sum += taps[i].y * textureLod(src, uv + taps[i].x * sigma_texels * texel, 0.0);
         }
     } else {
         float var = max(sigma_texels * sigma_texels - 1.0 / 6.0, 0.01 * sigma_texels * sigma_texels);
@@ -63,14 +56,10 @@ void main() {
         for (int k = -n; k <= n; ++k) {
             float x = float(k) * spacing;
             float w = exp(-0.5 * x * x / var);
-            fetch(x, p, size, ti, ts);
-            irr += w * ti;
-            str += w * ts;
+            sum += w * textureLod(src, uv + x * texel, 0.0);
             total += w;
         }
-        irr /= total;
-        str /= total;
+        sum /= total;
     }
-    imageStore(dst_irradiance, p, irr);
-    imageStore(dst_stretch, p, str);
+    imageStore(dst, p, sum);
 }

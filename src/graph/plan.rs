@@ -250,7 +250,11 @@ impl Graph {
         for (p, pass) in self.passes.iter().enumerate() {
             for (k, &(r, access)) in pass.uses.iter().enumerate() {
                 let res = &mut out[r];
-                if pass.uses[..k].iter().any(|&(other, _)| other == r) {
+                // The same read twice (one image sampled by two bindings) is one use.
+                if pass.uses[..k]
+                    .iter()
+                    .any(|&(other, a)| other == r && (a != access || access.info().writes))
+                {
                     return Err(Error::Graph(format!(
                         "pass {:?} declares {:?} twice; use one combined access",
                         pass.name, res.name
@@ -723,6 +727,23 @@ mod tests {
         p.write(&mut a, Access::TransferDst);
         p.record(|_| {});
         assert!(g.compile(&mut PoolState::default()).is_err());
+
+        // One image read twice with one access (two sampled bindings) is fine;
+        // read with two different accesses it is not.
+        for (second, ok) in [(Access::ComputeSampled, true), (Access::TransferSrc, false)] {
+            let mut g = Graph::new();
+            let mut a = image(&mut g, "a");
+            let mut b = image(&mut g, "b");
+            pass(&mut g, "fill", &[], &mut [(&mut a, Access::ComputeStorageWrite)]);
+            pass(
+                &mut g,
+                "read twice",
+                &[(&a, Access::ComputeSampled), (&a, second)],
+                &mut [(&mut b, Access::ComputeStorageWrite)],
+            );
+            pass(&mut g, "sink", &[(&b, Access::TransferSrc)], &mut []);
+            assert_eq!(g.compile(&mut PoolState::default()).is_ok(), ok, "{second:?}");
+        }
 
         let mut g = Graph::new();
         let mut out = g.import_image(

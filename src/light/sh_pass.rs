@@ -91,24 +91,30 @@ impl ShPasses {
     }
 
     /// Adds `sh_project` and `sh_reduce`; returns the coefficient buffer, written.
-    /// `readers`: the access the previous frame's readers used (for the first barrier).
+    /// `readers`: the access the previous frame's readers used (for the first
+    /// barrier). `project`: false keeps the coefficients a previous frame wrote (the
+    /// environment and its rotation are fixed for a render).
     pub fn passes(
         &self,
         g: &mut Graph,
         env: &Arc<Image>,
         b: &ShBuffers,
         readers: Access,
+        project: bool,
     ) -> BufferHandle {
-        let mut partials = g.import_buffer(
-            "sh partials",
-            Imported::Buffer(b.partials.clone()),
-            Some(Access::ComputeBufferRead),
-            None,
-        );
         let mut coefficients = g.import_buffer(
             "sh coefficients",
             Imported::Buffer(b.coefficients.clone()),
             Some(readers),
+            None,
+        );
+        if !project {
+            return coefficients;
+        }
+        let mut partials = g.import_buffer(
+            "sh partials",
+            Imported::Buffer(b.partials.clone()),
+            Some(Access::ComputeBufferRead),
             None,
         );
         // One workgroup per row, then one workgroup sums the rows.
@@ -139,7 +145,7 @@ pub fn project(
     let buffers = ShBuffers::new(ctx, &image, rotation_deg, intensity)?;
     let readback = Readback::new(ctx, "sh readback", 9 * 16)?;
     let mut g = Graph::new();
-    let coefficients = passes.passes(&mut g, &image, &buffers, Access::TransferSrc);
+    let coefficients = passes.passes(&mut g, &image, &buffers, Access::TransferSrc, true);
     readback.buffer_pass(&mut g, &coefficients);
     let mut ex = Executor::new(ctx, 1)?;
     let mut reports: Vec<FrameReport> = ex.run(g)?.into_iter().collect();

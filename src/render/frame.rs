@@ -22,11 +22,15 @@ use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
-use crate::skin::stretch::StretchPass;
+use crate::skin::chain::{self, Level};
+use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
-use crate::skin::{mean_stretch, SkinSettings};
+use crate::skin::{mean_stretch, stretch_percentile, SkinSettings};
 use ash::vk;
 use std::sync::Arc;
+
+/// Surface share whose stretch the adaptive chain is planned for (skin::chain).
+const STRETCH_PERCENTILE: f32 = 0.1;
 
 /// The shadow projection of each light the frame uses (`None`: unshadowed).
 fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
@@ -109,7 +113,7 @@ pub(super) struct Frame {
     tables: SpecularTables,
     skybox: SkyboxPass,
     direct: DirectPass,
-    stretch: StretchPass,
+    stretch: StretchMaps,
     irradiance: IrradiancePass,
     blur: BlurChain,
     shade: ShadePass,
@@ -122,7 +126,8 @@ pub(super) struct Frame {
     sh: ShPasses,
     sh_buffers: ShBuffers,
     skin: SkinSettings,
-    constant_stretch: Option<f32>,
+    /// The blur levels' resolutions (skin::chain).
+    levels: Vec<Level>,
     exposure: f32,
     gamma: Gamma,
 }
@@ -190,13 +195,23 @@ impl Frame {
             samplers.linear.clone(),
             samplers.nearest.clone(),
         )?;
+        let res = skin.resolution;
         let constant_stretch =
-            (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, skin.resolution));
+            (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
+        // The adaptive chain is planned for the stretch 90 % of the surface exceeds.
+        let texels_per_mm = constant_stretch
+            .unwrap_or_else(|| stretch_percentile(&scene.mesh, res, STRETCH_PERCENTILE));
+        let levels = chain::plan(&skin.profile, skin.chain, res, texels_per_mm);
+        log::info!(
+            "{:?} chain at {res}² ({texels_per_mm:.2} texels/mm): levels {:?}",
+            skin.chain,
+            levels
+        );
         Ok(Self {
             tables,
             skybox: SkyboxPass::new(ctx)?,
             direct: DirectPass::new(ctx, &inputs.variant)?,
-            stretch: StretchPass::new(ctx)?,
+            stretch: StretchMaps::new(ctx, res, &skin.profile, constant_stretch)?,
             irradiance: IrradiancePass::new(ctx, &inputs.variant)?,
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx, &inputs.variant)?,
@@ -214,7 +229,7 @@ impl Frame {
             )?,
             inputs,
             skin,
-            constant_stretch,
+            levels,
             exposure: scene.exposure(),
             gamma: scene.file.render.gamma,
         })
@@ -242,7 +257,7 @@ impl Frame {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let sh = self
             .sh
-            .passes(g, &self.inputs.env, &self.sh_buffers, Access::UniformRead);
+            .passes(g, &self.inputs.env, &self.sh_buffers, Access::UniformRead, first);
         if view == View::Prefiltered {
             return (self.prefilter.pass(g, &self.inputs.env, first), None);
         }
@@ -263,7 +278,7 @@ impl Frame {
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
-            let stretch = self.stretch.pass(g, mesh, res, self.constant_stretch);
+            let mut stretch = self.stretch.pass(g, mesh, &self.blur, first);
             let irradiance = self.irradiance.pass(
                 g,
                 &self.inputs,
@@ -274,17 +289,14 @@ impl Frame {
                 self.skin.mix,
             );
             if view == View::Stretch {
-                return (stretch, None);
+                return (stretch.swap_remove(0), None);
             }
             if view == View::Irradiance {
                 return (irradiance, None);
             }
-            let levels = self
-                .blur
-                .chain(g, &irradiance, &stretch, &self.skin.profile);
+            let mut levels = self.blur.chain(g, irradiance, &stretch, &self.levels);
             if let View::Blur(k) = view {
-                let mut irr = levels.irradiance;
-                return (irr.swap_remove(k as usize - 1), None);
+                return (levels.swap_remove(k as usize - 1), None);
             }
             let specular_env = self.prefilter.pass(g, &self.inputs.env, first);
             self.skybox.pass(g, &self.inputs, &mut hdr);
@@ -311,7 +323,7 @@ impl Frame {
                 &self.inputs,
                 &self.tables,
                 ShadeImages {
-                    levels: &levels.irradiance,
+                    levels: &levels,
                     shadows: &shadows,
                     specular_env: &specular_env,
                 },

@@ -136,8 +136,12 @@ pub fn render_scene(
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
     let run_setup = setup(scene, opts, skin.resolution);
-    let (w, h) = opts.view.size(screen, skin.resolution);
     let frame = Frame::new(ctx, scene, skin)?;
+    // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
+    let (w, h) = {
+        let (image, _) = frame.graph(&mut Graph::new(), opts.view, screen, true);
+        (image.desc.width, image.desc.height)
+    };
     let readback = |name: &str, bytes_per_texel: u64| {
         Readback::new(ctx, name, w as u64 * h as u64 * bytes_per_texel)
     };

@@ -2,7 +2,6 @@
 //! views).
 
 use crate::error::{Error, Result};
-use crate::light::prefilter;
 
 /// What `render` writes: the final image or one intermediate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,15 +80,6 @@ impl View {
             self,
             View::Irradiance | View::Stretch | View::Blur(_) | View::Prefiltered
         )
-    }
-
-    /// The size of the image the view reads back.
-    pub(super) fn size(self, screen: (u32, u32), irradiance_resolution: u32) -> (u32, u32) {
-        match self {
-            View::Prefiltered => (prefilter::WIDTH, prefilter::HEIGHT * prefilter::LEVELS),
-            v if v.uv_space() => (irradiance_resolution, irradiance_resolution),
-            _ => screen,
-        }
     }
 }
 

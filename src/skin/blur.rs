@@ -1,26 +1,31 @@
 //! The six-Gaussian blur chain (GPU Gems 3 §14.4.2; the paper's eq. 4-5 and
 //! Fig. 3): level k blurs level k−1 by σ_k = √(v_k − v_{k−1}) mm, separably (U then
-//! V), with taps spaced by the stretch map, which is blurred alongside.
+//! V), with taps spaced by the stretch map's level k−1 (skin::stretch). Levels
+//! may be coarser than their predecessor (skin::chain): the U pass then writes
+//! the new width, the V pass the new height.
 //!
 //! Every UV target is coverage-premultiplied (alpha = 1 on the mesh, 0 in the
 //! gutter), so the chain is a plain linear convolution of (I·a, a) and dividing by
 //! alpha at lookup gives the convolution normalised over the mesh: blurs never
 //! pull the gutter's black into chart borders, however wide the kernel.
 
-use super::profile::{Kernel, Profile};
+use super::chain::Level;
+use super::profile::Kernel;
 use super::UV_FORMAT;
-use crate::error::Result;
-use crate::gpu::{Buffer, Context, Pipeline, Sampler};
+use crate::error::{Error, Result};
+use crate::gpu::{Buffer, Context, ImageDesc, Pipeline, Sampler};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, Graph, ImageHandle};
 use std::sync::Arc;
+
+/// Taps the fixed-kernel uniform block holds (blur.comp).
+pub const MAX_FIXED_TAPS: usize = 32;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct BlurPush {
     dir: [i32; 2],
     sigma_mm: f32,
-    tap_count: i32,
 }
 
 /// Which taps each blur pass uses.
@@ -36,112 +41,102 @@ pub enum BlurKernel {
 pub struct BlurChain {
     pipeline: Arc<Pipeline>,
     taps: Arc<Buffer>,
-    /// 0 selects the accurate kernel in the shader.
-    tap_count: i32,
     sampler: Arc<Sampler>,
-}
-
-/// The chain's outputs: irradiance levels 1..=6 and the stretch levels blurred
-/// alongside (level k's taps are spaced by stretch level k−1).
-pub struct Levels {
-    pub irradiance: Vec<ImageHandle>,
-    pub stretch: Vec<ImageHandle>,
 }
 
 impl BlurChain {
     pub fn new(ctx: &Arc<Context>, kernel: &BlurKernel, sampler: Arc<Sampler>) -> Result<Self> {
-        let taps: Vec<[f32; 2]> = match kernel {
-            BlurKernel::Fixed(k) => k
-                .offsets_sigma
-                .iter()
-                .zip(&k.weights)
-                .map(|(&o, &w)| [o, w])
-                .collect(),
-            // The buffer must exist (the shader declares it); the accurate path ignores it.
-            BlurKernel::Accurate => vec![[0.0, 1.0]],
-        };
+        // std140: one vec4 (offset in σ, weight, 0, 0) per tap.
+        let mut taps = [[0.0f32; 4]; MAX_FIXED_TAPS];
         let tap_count = match kernel {
-            BlurKernel::Fixed(_) => taps.len() as i32,
+            BlurKernel::Fixed(k) => {
+                if k.weights.len() > MAX_FIXED_TAPS {
+                    return Err(Error::Input(format!(
+                        "blur kernel of {} taps: at most {MAX_FIXED_TAPS}",
+                        k.weights.len()
+                    )));
+                }
+                for (t, (&o, &w)) in taps.iter_mut().zip(k.offsets_sigma.iter().zip(&k.weights)) {
+                    *t = [o, w, 0.0, 0.0];
+                }
+                k.weights.len() as u32
+            }
             BlurKernel::Accurate => 0,
         };
         Ok(Self {
-            pipeline: Pipeline::compute(ctx, "blur.comp")?,
+            pipeline: Pipeline::compute_specialized(ctx, "blur.comp", &[tap_count])?,
             taps: upload_buffer(
                 ctx,
                 "blur kernel",
                 bytemuck::cast_slice(&taps),
-                Access::ComputeBufferRead,
+                Access::UniformRead,
             )?,
-            tap_count,
             sampler,
         })
     }
 
+    /// The irradiance levels 1..=6 as `levels` plans them; level k's taps are
+    /// spaced by `stretch[k − 1]`. A level without a σ is its predecessor's image
+    /// (the first: `irradiance` itself).
     pub fn chain(
         &self,
         g: &mut Graph,
-        irradiance: &ImageHandle,
-        stretch: &ImageHandle,
-        profile: &Profile,
-    ) -> Levels {
-        let mut levels = Levels {
-            irradiance: Vec::new(),
-            stretch: Vec::new(),
-        };
-        let desc = irradiance.desc;
-        for (k, sigma) in profile.increments().into_iter().enumerate() {
-            let (src_i, src_s) = match k {
-                0 => (irradiance, stretch),
-                _ => (&levels.irradiance[k - 1], &levels.stretch[k - 1]),
+        irradiance: ImageHandle,
+        stretch: &[ImageHandle],
+        levels: &[Level],
+    ) -> Vec<ImageHandle> {
+        let mut out: Vec<ImageHandle> = Vec::new();
+        let mut unblurred = Some(irradiance);
+        for (k, level) in levels.iter().enumerate() {
+            let Some(sigma) = level.sigma_mm else {
+                // Only a first level can be skipped (skin::chain::plan).
+                out.extend(unblurred.take());
+                continue;
             };
-            let mut tmp_i = g.create_image("blur_tmp", desc);
-            let mut tmp_s = g.create_image("stretch_tmp", desc);
-            self.pass(
-                g,
-                &format!("blur{}_u", k + 1),
-                (src_i, src_s),
-                (&mut tmp_i, &mut tmp_s),
-                [1, 0],
-                sigma,
-            );
-            let mut out_i = g.create_image(&format!("blur{}", k + 1), desc);
-            let mut out_s = g.create_image(&format!("stretch{}", k + 1), desc);
-            self.pass(
-                g,
-                &format!("blur{}_v", k + 1),
-                (&tmp_i, &tmp_s),
-                (&mut out_i, &mut out_s),
-                [0, 1],
-                sigma,
-            );
-            levels.irradiance.push(out_i);
-            levels.stretch.push(out_s);
+            let name = format!("blur{}", k + 1);
+            let desc = ImageDesc::new(level.resolution, level.resolution, UV_FORMAT);
+            let mut dst = g.create_image(&name, desc);
+            let src = out.last().or(unblurred.as_ref()).expect("a source level");
+            self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            out.push(dst);
         }
-        debug_assert!(desc.format == UV_FORMAT);
-        levels
+        out
+    }
+
+    /// One Gaussian of σ mm, separably, from `src` into `dst` (whose side may be
+    /// smaller): `{name}_u` writes dst's width × src's height, `{name}_v` dst.
+    pub fn gaussian(
+        &self,
+        g: &mut Graph,
+        name: &str,
+        src: &ImageHandle,
+        stretch: &ImageHandle,
+        sigma_mm: f32,
+        dst: &mut ImageHandle,
+    ) {
+        let tmp_desc = ImageDesc::new(dst.desc.width, src.desc.height, UV_FORMAT);
+        let mut tmp = g.create_image(&format!("{name}_tmp"), tmp_desc);
+        self.pass(g, &format!("{name}_u"), src, stretch, &mut tmp, [1, 0], sigma_mm);
+        self.pass(g, &format!("{name}_v"), &tmp, stretch, dst, [0, 1], sigma_mm);
     }
 
     fn pass(
         &self,
         g: &mut Graph,
         name: &str,
-        src: (&ImageHandle, &ImageHandle),
-        dst: (&mut ImageHandle, &mut ImageHandle),
+        src: &ImageHandle,
+        stretch: &ImageHandle,
+        dst: &mut ImageHandle,
         dir: [i32; 2],
         sigma_mm: f32,
     ) {
-        let (w, h) = (dst.0.desc.width, dst.0.desc.height);
+        let (w, h) = (dst.desc.width, dst.desc.height);
         g.simple_pass(name, &self.pipeline)
-            .sample(src.0, &self.sampler)
-            .sample(src.1, &self.sampler)
-            .store(dst.0)
-            .store(dst.1)
-            .buffer(&self.taps)
-            .constants(&BlurPush {
-                dir,
-                sigma_mm,
-                tap_count: self.tap_count,
-            })
+            .sample(src, &self.sampler)
+            .sample(stretch, &self.sampler)
+            .store(dst)
+            .uniform(&self.taps)
+            .constants(&BlurPush { dir, sigma_mm })
             .dispatch([w, h, 1]);
     }
 }

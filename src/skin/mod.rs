@@ -3,6 +3,7 @@
 //! and the paper's section II.B) and the Kelemen/Szirmay-Kalos specular term.
 
 pub mod blur;
+pub mod chain;
 pub mod irradiance;
 pub mod profile;
 pub mod shade;
@@ -13,7 +14,7 @@ pub mod tables;
 use crate::error::{Error, Result};
 use crate::frame::Vertex;
 use crate::gpu::{Context, GraphicsDesc, Pipeline};
-use crate::scene::file::{Kernel as KernelChoice, Render, Skin, SpecularRegion};
+use crate::scene::file::{Chain, Kernel as KernelChoice, Render, Skin, SpecularRegion};
 use crate::scene::mesh::Mesh;
 use ash::vk;
 use blur::BlurKernel;
@@ -33,6 +34,8 @@ pub struct SkinSettings {
     /// KS parameters of the ten face regions (specular::REGION_NAMES order).
     pub regions: Vec<SpecularRegion>,
     pub kernel: BlurKernel,
+    /// Resolutions of the blur levels (skin::chain).
+    pub chain: Chain,
     /// Pre-scatter share of the albedo (d'Eon & Luebke §14.5: 0.5).
     pub mix: f32,
     /// Side of the UV-space targets (power of two, 256..=8192).
@@ -82,6 +85,7 @@ impl SkinSettings {
                 KernelChoice::Deon7 => BlurKernel::Fixed(Kernel::deon7()),
                 KernelChoice::Accurate => BlurKernel::Accurate,
             },
+            chain: skin.chain,
             mix: skin.mix,
             resolution: render.irradiance_resolution,
             stretch_correction: skin.stretch_correction,
@@ -106,6 +110,35 @@ pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
     } else {
         1.0
     }
+}
+
+/// Texels per millimetre at `resolution` that a fraction `1 − q` of the surface
+/// area exceeds (per triangle √(UV area in texels² / area in mm²)): the stretch the
+/// adaptive chain is planned for, so that it is fine enough almost everywhere.
+pub fn stretch_percentile(mesh: &Mesh, resolution: u32, q: f32) -> f32 {
+    let mut tris: Vec<(f32, f64)> = mesh
+        .indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let p = |i: usize| mesh.positions[i];
+            let area = 0.5 * (p(b) - p(a)).cross(p(c) - p(a)).length() as f64;
+            let (ua, ub, uc) = (mesh.uvs[a], mesh.uvs[b], mesh.uvs[c]);
+            let uv_area = 0.5 * ((ub - ua).perp_dot(uc - ua)).abs() as f64;
+            (area > 0.0 && uv_area > 0.0)
+                .then(|| (((uv_area / area).sqrt() * resolution as f64) as f32, area))
+        })
+        .collect();
+    tris.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let total: f64 = tris.iter().map(|t| t.1).sum();
+    let mut acc = 0.0;
+    for (stretch, area) in &tris {
+        acc += area;
+        if acc >= q as f64 * total {
+            return *stretch;
+        }
+    }
+    mean_stretch(mesh, resolution)
 }
 
 /// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.

@@ -1,39 +1,101 @@
-//! The stretch map (GPU Gems 3 §14.4.3; the paper's Fig. 3 top row): texels per
-//! mm along u and v for every texel, recomputed every frame so deforming meshes
-//! work.
+//! The stretch maps (GPU Gems 3 §14.4.3; the paper's Fig. 3 top row): texels per
+//! mm along u and v for every texel, and the chain of them blurred with the
+//! profile's Gaussians (blurred level k−1 spaces the taps of level k). They depend
+//! on the mesh alone, which is rigid for a render: they are computed in its first
+//! frame, at most [`MAX_RESOLUTION`]² (stretch varies smoothly; the blur reads it
+//! bilinearly at any resolution), and kept.
 
+use super::blur::BlurChain;
+use super::profile::Profile;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::frame::MeshBuffers;
-use crate::gpu::{Context, ImageDesc, Pipeline};
-use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::gpu::{Context, Image, ImageDesc, Pipeline};
+use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
+use ash::vk;
 use std::sync::Arc;
 
-pub struct StretchPass {
+/// Largest side of the stretch maps.
+pub const MAX_RESOLUTION: u32 = 1024;
+
+pub struct StretchMaps {
     pipeline: Arc<Pipeline>,
+    /// Levels 0 (unblurred) ..= 5: what blur levels 1..=6 are spaced by.
+    levels: Vec<Arc<Image>>,
+    /// `Some(texels_per_mm)` at the irradiance resolution: no stretch correction.
+    constant: Option<f32>,
+    increments: Vec<f32>,
+    /// Irradiance resolution ÷ stretch resolution (a constant stretch is given
+    /// at the irradiance resolution).
+    scale: f32,
 }
 
-impl StretchPass {
-    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+impl StretchMaps {
+    /// Stretch maps for an irradiance chain at `resolution`² with `profile`.
+    pub fn new(
+        ctx: &Arc<Context>,
+        resolution: u32,
+        profile: &Profile,
+        constant: Option<f32>,
+    ) -> Result<Self> {
+        let side = resolution.min(MAX_RESOLUTION);
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let mut increments = profile.increments();
+        increments.truncate(increments.len().saturating_sub(1));
+        let levels = (0..=increments.len())
+            .map(|k| {
+                let desc = ImageDesc::new(side, side, UV_FORMAT);
+                Image::new(ctx, &format!("stretch{k}"), desc, usage).map(Arc::new)
+            })
+            .collect::<Result<_>>()?;
         Ok(Self {
             pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag", &[])?,
+            levels,
+            constant,
+            increments,
+            scale: resolution as f32 / side as f32,
         })
     }
 
-    /// `constant`: `Some(texels_per_mm)` disables stretch correction.
+    /// The stretch levels 0..=5 as graph images; `first`: the render's first
+    /// frame, which computes them (passes `stretch` and `stretch{k}_u/_v`).
     pub fn pass(
         &self,
         g: &mut Graph,
         mesh: &MeshBuffers,
-        resolution: u32,
-        constant: Option<f32>,
-    ) -> ImageHandle {
-        let mut out = g.create_image("stretch", ImageDesc::new(resolution, resolution, UV_FORMAT));
-        let pass = g
-            .simple_pass("stretch", &self.pipeline)
-            .color(&mut out, LoadOp::Clear([0.0; 4]))
-            .constants(&constant.unwrap_or(0.0));
-        mesh.draw(pass);
+        blur: &BlurChain,
+        first: bool,
+    ) -> Vec<ImageHandle> {
+        let initial = (!first).then_some(Access::ShaderSampled);
+        let mut out: Vec<ImageHandle> = self
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(k, image)| {
+                g.import_image(
+                    &format!("stretch{k}"),
+                    Imported::Image(image.clone()),
+                    initial,
+                    Some(Access::ShaderSampled),
+                )
+            })
+            .collect();
+        if first {
+            let constant = self.constant.map_or(0.0, |c| c / self.scale);
+            let pass = g
+                .simple_pass("stretch", &self.pipeline)
+                .color(&mut out[0], LoadOp::Clear([0.0; 4]))
+                .constants(&constant);
+            mesh.draw(pass);
+            for (k, &sigma) in self.increments.iter().enumerate() {
+                let (done, rest) = out.split_at_mut(k + 1);
+                let name = format!("stretch{}", k + 1);
+                blur.gaussian(g, &name, &done[k], &done[k], sigma, &mut rest[0]);
+            }
+        }
         out
     }
 }

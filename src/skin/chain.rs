@@ -1,0 +1,139 @@
+//! The resolution of every level of the diffusion chain. `full` blurs all six
+//! Gaussians at the irradiance resolution (GPU Gems 3 §14.5). `adaptive` stores
+//! each level at the coarsest power of two at which its total width still spans
+//! [`MIN_SIGMA_TEXELS`] texels, downsampling as it blurs (the Gaussian is the
+//! low-pass filter), and takes the unblurred irradiance for a first Gaussian
+//! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
+//! first term). docs/performance.md shows what it costs and how far it is off.
+
+use super::profile::Profile;
+use crate::scene::file::Chain;
+
+/// Smallest total σ, in texels of its own resolution, a level is stored with.
+/// 1.5 texels keeps bilinear lookups of a Gaussian-smooth level within a few
+/// 0.1 % (measured with `dermis sweep`, docs/performance.md).
+pub const MIN_SIGMA_TEXELS: f32 = 1.5;
+/// A first increment narrower than this (texels at the irradiance resolution) is
+/// not blurred: the level is the irradiance itself.
+pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
+/// The coarsest level the adaptive chain goes down to.
+pub const MIN_RESOLUTION: u32 = 64;
+
+/// One level of the chain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Level {
+    /// Side of the level's image.
+    pub resolution: u32,
+    /// σ (mm) of the blur from the previous level's image to this one; `None`:
+    /// the level is the previous image, unblurred.
+    pub sigma_mm: Option<f32>,
+}
+
+/// Plans the six levels. `texels_per_mm`: the stretch the adaptive choice is made
+/// for at `resolution` (skin::stretch_percentile: most of the surface has more).
+pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32) -> Vec<Level> {
+    let mut levels = Vec::new();
+    let (mut previous_variance, mut previous_resolution) = (0.0f32, resolution);
+    for (k, g) in profile.gaussians.iter().enumerate() {
+        let increment = (g.variance_mm2 - previous_variance).max(0.0).sqrt();
+        let level = match chain {
+            Chain::Full => Level {
+                resolution,
+                sigma_mm: Some(increment),
+            },
+            Chain::Adaptive if k == 0 && increment * texels_per_mm < SKIP_SIGMA_TEXELS => Level {
+                resolution,
+                sigma_mm: None,
+            },
+            Chain::Adaptive => {
+                let sigma = g.variance_mm2.sqrt();
+                let mut r = previous_resolution;
+                while r / 2 >= MIN_RESOLUTION
+                    && sigma * texels_per_mm * (r / 2) as f32 / resolution as f32
+                        >= MIN_SIGMA_TEXELS
+                {
+                    r /= 2;
+                }
+                Level {
+                    resolution: r,
+                    sigma_mm: Some(increment),
+                }
+            }
+        };
+        if level.sigma_mm.is_some() {
+            previous_variance = g.variance_mm2;
+        }
+        previous_resolution = level.resolution;
+        levels.push(level);
+    }
+    levels
+}
+
+/// Texels written by the blur passes of a plan whose input is `resolution`²
+/// (U pass: new width × old height; V pass: new side²).
+pub fn blurred_texels(levels: &[Level], resolution: u32) -> u64 {
+    let mut previous = resolution as u64;
+    let mut texels = 0;
+    for l in levels {
+        let r = l.resolution as u64;
+        if l.sigma_mm.is_some() {
+            texels += r * previous + r * r;
+        }
+        previous = r;
+    }
+    texels
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_full_chain_blurs_every_level_at_the_irradiance_resolution() {
+        let p = Profile::skin();
+        let levels = plan(&p, Chain::Full, 1024, 4.0);
+        assert_eq!(levels.len(), 6);
+        for (l, inc) in levels.iter().zip(p.increments()) {
+            assert_eq!(l.resolution, 1024);
+            assert_eq!(l.sigma_mm, Some(inc));
+        }
+    }
+
+    #[test]
+    fn adaptive_levels_keep_their_width_in_texels_and_the_total_variance() {
+        let p = Profile::skin();
+        let (res, stretch) = (4096, 16.0);
+        let levels = plan(&p, Chain::Adaptive, res, stretch);
+        // σ1 = 0.08 mm is 1.3 texels: the irradiance itself.
+        assert_eq!(levels[0].sigma_mm, None);
+        assert_eq!(levels[0].resolution, res);
+        let mut variance = 0.0;
+        let mut previous = res;
+        for (l, g) in levels.iter().zip(&p.gaussians).skip(1) {
+            variance += l.sigma_mm.unwrap().powi(2);
+            // Each computed level has the profile's total variance…
+            assert!((variance - g.variance_mm2).abs() < 1e-5, "{l:?}");
+            // …spans at least MIN_SIGMA_TEXELS texels, and half its side would not.
+            let texels = |r: u32| g.variance_mm2.sqrt() * stretch * r as f32 / res as f32;
+            assert!(texels(l.resolution) >= MIN_SIGMA_TEXELS, "{l:?}");
+            assert!(l.resolution <= previous);
+            assert!(
+                texels(l.resolution / 2) < MIN_SIGMA_TEXELS
+                    || l.resolution == previous
+                    || l.resolution == MIN_RESOLUTION,
+                "{l:?}"
+            );
+            previous = l.resolution;
+        }
+        let full = blurred_texels(&plan(&p, Chain::Full, res, stretch), res);
+        let adaptive = blurred_texels(&levels, res);
+        assert!(adaptive * 8 < full, "{adaptive} vs {full}");
+    }
+
+    #[test]
+    fn a_wide_first_gaussian_is_blurred() {
+        // At 64 texels/mm σ1 = 0.08 mm spans 5 texels.
+        let p = Profile::skin();
+        assert!(plan(&p, Chain::Adaptive, 1024, 64.0)[0].sigma_mm.is_some());
+    }
+}
