@@ -23,10 +23,9 @@ layout(location = 6) in vec3 v_t678;
 #define SPEC_REGIONS 7
 #define SPEC_INTENSITY 8
 #define SPEC_ROUGHNESS 9
-#define SPEC_PARAMS 10
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
-#define SHADOW_ATLAS 11
+#define SHADOW_ATLAS 10
 #include "lights.glsl"
 #define ENERGY_CONSERVING_LIGHTS
 #include "lighting.glsl"

@@ -25,7 +25,6 @@ layout(binding = 11) uniform sampler2D blur6;
 #define SPEC_REGIONS 14
 #define SPEC_INTENSITY 15
 #define SPEC_ROUGHNESS 16
-#define SPEC_PARAMS 17
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
@@ -41,7 +40,7 @@ layout(location = 6) in vec3 v_t678;
 layout(location = 0) out vec4 color;
 
 vec3 level(sampler2D t, int i) {
-    vec4 b = texture(t, v_uv);
+    vec4 b = textureLod(t, v_uv, 0.0);
     return pc.weights[i].rgb * (b.rgb / max(b.a, 1e-4));
 }
 

@@ -3,17 +3,16 @@
 // (numbers set by the including shader through the SPEC_* macros):
 //   SPEC_BECKMANN  sampler2D  D(N·H, m), skin/specular.rs::beckmann_lut
 //   SPEC_ALBEDO    sampler2D  A(cos θ, m), skin/specular.rs::specular_albedo_lut
-//   SPEC_REGIONS   sampler2D  region id in R (texel = id / 255)
+//   SPEC_REGIONS   sampler2D  (ρs, m) blended from the face regions' parameters
+//                             (skin/specular.rs::region_params_map), nearest
 //   SPEC_INTENSITY sampler2D  ρs scale (the specular map)
 //   SPEC_ROUGHNESS sampler2D  m (grey), used when ROUGHNESS_MAP (frame.glsl)
-//   SPEC_PARAMS    uniform    per region (ρs, m)
 #include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
 layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
-layout(binding = SPEC_REGIONS) uniform sampler2D region_tex;
+layout(binding = SPEC_REGIONS) uniform sampler2D region_params;
 layout(binding = SPEC_INTENSITY) uniform sampler2D intensity_tex;
 layout(binding = SPEC_ROUGHNESS) uniform sampler2D roughness_tex;
-layout(std140, binding = SPEC_PARAMS) uniform RegionParams { vec4 region_params[10]; };
 
 // Endpoint-inclusive tables (skin/specular.rs::table_point): x = i/(n−1) at texel i.
 vec2 table_uv(sampler2D table, vec2 x) {
@@ -21,25 +20,10 @@ vec2 table_uv(sampler2D table, vec2 x) {
     return (clamp(x, 0.0, 1.0) * (n - 1.0) + 0.5) / n;
 }
 
-const float REGION_BLEND_TEXELS = 4.0;   // region borders blend over ±8 texels
-
-// (ρs, m) at uv: region parameters blended with tent weights over a 3×3 grid of
-// region-map texels REGION_BLEND_TEXELS apart, so borders are soft, not hard edges.
+// (ρs, m) at uv: the face region's (soft at borders), ρs scaled by the specular
+// map, m from the roughness map where the scene gives one.
 vec2 specular_params(vec2 uv) {
-    ivec2 size = textureSize(region_tex, 0);
-    vec2 acc = vec2(0.0);
-    float total = 0.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-            vec2 p = uv * vec2(size) + vec2(dx, dy) * REGION_BLEND_TEXELS;
-            ivec2 t = clamp(ivec2(floor(p)), ivec2(0), size - 1);
-            int id = min(int(texelFetch(region_tex, t, 0).r * 255.0 + 0.5), 9);
-            float w = (2.0 - abs(float(dx))) * (2.0 - abs(float(dy)));
-            acc += w * region_params[id].xy;
-            total += w;
-        }
-    }
-    vec2 params = acc / total;
+    vec2 params = textureLod(region_params, uv, 0.0).xy;
     params.x *= texture(intensity_tex, uv).r;
     if (ROUGHNESS_MAP) params.y = texture(roughness_tex, uv).r;
     params.y = clamp(params.y, 0.02, 1.0);

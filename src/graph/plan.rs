@@ -734,7 +734,12 @@ mod tests {
             let mut g = Graph::new();
             let mut a = image(&mut g, "a");
             let mut b = image(&mut g, "b");
-            pass(&mut g, "fill", &[], &mut [(&mut a, Access::ComputeStorageWrite)]);
+            pass(
+                &mut g,
+                "fill",
+                &[],
+                &mut [(&mut a, Access::ComputeStorageWrite)],
+            );
             pass(
                 &mut g,
                 "read twice",
@@ -742,7 +747,11 @@ mod tests {
                 &mut [(&mut b, Access::ComputeStorageWrite)],
             );
             pass(&mut g, "sink", &[(&b, Access::TransferSrc)], &mut []);
-            assert_eq!(g.compile(&mut PoolState::default()).is_ok(), ok, "{second:?}");
+            assert_eq!(
+                g.compile(&mut PoolState::default()).is_ok(),
+                ok,
+                "{second:?}"
+            );
         }
 
         let mut g = Graph::new();

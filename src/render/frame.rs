@@ -20,9 +20,9 @@ use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::scene::file::{Gamma, Occlusion};
 use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
+use crate::skin::chain::{self, Level};
 use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
-use crate::skin::chain::{self, Level};
 use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
 use crate::skin::{mean_stretch, stretch_percentile, SkinSettings};
@@ -192,12 +192,12 @@ impl Frame {
         let tables = SpecularTables::new(
             ctx,
             &skin.regions,
+            &scene.regions,
             samplers.linear.clone(),
             samplers.nearest.clone(),
         )?;
         let res = skin.resolution;
-        let constant_stretch =
-            (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
+        let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
         // The adaptive chain is planned for the stretch 90 % of the surface exceeds.
         let texels_per_mm = constant_stretch
             .unwrap_or_else(|| stretch_percentile(&scene.mesh, res, STRETCH_PERCENTILE));
@@ -255,9 +255,13 @@ impl Frame {
         first: bool,
     ) -> (ImageHandle, Option<ImageHandle>) {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
-        let sh = self
-            .sh
-            .passes(g, &self.inputs.env, &self.sh_buffers, Access::UniformRead, first);
+        let sh = self.sh.passes(
+            g,
+            &self.inputs.env,
+            &self.sh_buffers,
+            Access::UniformRead,
+            first,
+        );
         if view == View::Prefiltered {
             return (self.prefilter.pass(g, &self.inputs.env, first), None);
         }

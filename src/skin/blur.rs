@@ -116,8 +116,24 @@ impl BlurChain {
     ) {
         let tmp_desc = ImageDesc::new(dst.desc.width, src.desc.height, UV_FORMAT);
         let mut tmp = g.create_image(&format!("{name}_tmp"), tmp_desc);
-        self.pass(g, &format!("{name}_u"), src, stretch, &mut tmp, [1, 0], sigma_mm);
-        self.pass(g, &format!("{name}_v"), &tmp, stretch, dst, [0, 1], sigma_mm);
+        self.pass(
+            g,
+            &format!("{name}_u"),
+            src,
+            stretch,
+            &mut tmp,
+            [1, 0],
+            sigma_mm,
+        );
+        self.pass(
+            g,
+            &format!("{name}_v"),
+            &tmp,
+            stretch,
+            dst,
+            [0, 1],
+            sigma_mm,
+        );
     }
 
     fn pass(

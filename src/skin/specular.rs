@@ -265,6 +265,42 @@ pub fn default_regions() -> [Region; 10] {
     })
 }
 
+/// Region-map texels between the 3×3 samples blended per texel (±8 texels).
+pub const REGION_BLEND_TEXELS: i64 = 4;
+
+/// (ρs, m) per texel of the region map (id = red byte, clamped to the last
+/// region): the regions' parameters blended with tent weights 1-2-1 over a 3×3
+/// grid of texels [`REGION_BLEND_TEXELS`] apart, so borders are soft, not hard
+/// edges. Computed once per scene; the shaders read it with nearest filtering.
+pub fn region_params_map(
+    width: u32,
+    height: u32,
+    rgba8: &[u8],
+    params: &[[f32; 2]],
+) -> Vec<[f32; 2]> {
+    let (w, h) = (width as i64, height as i64);
+    let last = params.len() - 1;
+    let id = |x: i64, y: i64| {
+        let t = (y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize;
+        (rgba8[4 * t] as usize).min(last)
+    };
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let mut acc = [0.0f32; 2];
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let weight = ((2 - dx.abs()) * (2 - dy.abs())) as f32 / 16.0;
+                    let p = params[id(x + dx * REGION_BLEND_TEXELS, y + dy * REGION_BLEND_TEXELS)];
+                    acc[0] += weight * p[0];
+                    acc[1] += weight * p[1];
+                }
+            }
+            acc
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -506,6 +542,33 @@ mod tests {
             sample_lut(&lut, 16, 16, texel_centre(4, 16), texel_centre(7, 16)),
             lut[7 * 16 + 4]
         );
+    }
+
+    #[test]
+    fn region_parameters_blend_across_borders_only() {
+        // Left half region 0, right half region 2; ids beyond the list clamp.
+        let (w, h) = (32u32, 4u32);
+        let rgba8: Vec<u8> = (0..w * h)
+            .flat_map(|i| [if i % w < w / 2 { 0 } else { 200 }, 0, 0, 255])
+            .collect();
+        let params = [[0.1, 0.2], [0.5, 0.5], [0.3, 0.6]];
+        let map = region_params_map(w, h, &rgba8, &params);
+        let at = |x: u32| map[(w + x) as usize];
+        assert_eq!(at(0), [0.1, 0.2]);
+        assert_eq!(at(w - 1), [0.3, 0.6]);
+        // One texel left of the border the right-hand samples (weight 4/16) reach.
+        let border = at(w / 2 - 1);
+        assert!(
+            (border[0] - (0.75 * 0.1 + 0.25 * 0.3)).abs() < 1e-6,
+            "{border:?}"
+        );
+        assert!(
+            (border[1] - (0.75 * 0.2 + 0.25 * 0.6)).abs() < 1e-6,
+            "{border:?}"
+        );
+        // Beyond ±4 texels of the border nothing blends.
+        assert_eq!(at(w / 2 - 5), [0.1, 0.2]);
+        assert_eq!(at(w / 2 + 4), [0.3, 0.6]);
     }
 
     #[test]

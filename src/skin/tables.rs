@@ -1,14 +1,16 @@
 //! The specular term's GPU inputs (GPU Gems 3 §14.3): the Beckmann table D(N·H, m),
 //! the specular albedo table A(cos θ, m) for energy conservation, both computed by
-//! dermis at start-up (skin/specular.rs), and the per-region (ρs, m) table.
+//! dermis at start-up (skin/specular.rs), and the map of (ρs, m) blended from the
+//! face regions' parameters.
 
 use super::specular;
 use crate::error::Result;
 use crate::frame::FrameInputs;
-use crate::gpu::{Buffer, Context, Image, ImageDesc, Sampler};
-use crate::graph::upload::{upload_buffer, upload_texture};
-use crate::graph::{Access, SimplePass};
-use crate::scene::file::SpecularRegion;
+use crate::gpu::{Context, Image, ImageDesc, Sampler};
+use crate::graph::upload::upload_texture;
+use crate::graph::SimplePass;
+use crate::scene::file::{SpecularRegion, REGION_COUNT};
+use crate::scene::texture::Texture;
 use ash::vk;
 use std::sync::Arc;
 
@@ -38,8 +40,9 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
 pub struct SpecularTables {
     pub beckmann: Arc<Image>,
     pub albedo: Arc<Image>,
-    /// Ten vec4 (ρs, m, 0, 0), indexed by the region map.
-    pub regions: Arc<Buffer>,
+    /// (ρs, m) per region-map texel, blended across region borders
+    /// (specular::region_params_map), RGBA16F.
+    pub params: Arc<Image>,
     /// Linear where the device filters R32F, else nearest.
     pub sampler: Arc<Sampler>,
 }
@@ -48,6 +51,7 @@ impl SpecularTables {
     pub fn new(
         ctx: &Arc<Context>,
         regions: &[SpecularRegion],
+        region_map: &Texture,
         linear: Arc<Sampler>,
         nearest: Arc<Sampler>,
     ) -> Result<Self> {
@@ -55,13 +59,20 @@ impl SpecularTables {
             let desc = ImageDesc::new(size as u32, size as u32, vk::Format::R32_SFLOAT);
             upload_texture(ctx, name, desc, bytemuck::cast_slice(&values))
         };
-        let params: Vec<[f32; 4]> = (0..10)
+        let params: Vec<[f32; 2]> = (0..REGION_COUNT)
             .map(|i| {
-                regions.get(i).map_or(
-                    [specular::DEFAULT_RHO_S, specular::DEFAULT_M, 0.0, 0.0],
-                    |r| [r.rho_s, r.m, 0.0, 0.0],
-                )
+                regions
+                    .get(i)
+                    .map_or([specular::DEFAULT_RHO_S, specular::DEFAULT_M], |r| {
+                        [r.rho_s, r.m]
+                    })
             })
+            .collect();
+        let (w, h) = (region_map.width, region_map.height);
+        let map: Vec<u8> = specular::region_params_map(w, h, &region_map.rgba8, &params)
+            .iter()
+            .flat_map(|&[rho_s, m]| [rho_s, m, 0.0, 1.0])
+            .flat_map(|v| half::f16::from_f32(v).to_le_bytes())
             .collect();
         Ok(Self {
             beckmann: table(
@@ -74,11 +85,11 @@ impl SpecularTables {
                 ALBEDO_SIZE,
                 specular::specular_albedo_lut(ALBEDO_SIZE, ALBEDO_SIZE, 256, 64),
             )?,
-            regions: upload_buffer(
+            params: upload_texture(
                 ctx,
-                "region parameters",
-                bytemuck::cast_slice(&params),
-                Access::UniformRead,
+                "specular parameters",
+                ImageDesc::new(w, h, vk::Format::R16G16B16A16_SFLOAT),
+                &map,
             )?,
             sampler: if ctx.supports_linear_filter(vk::Format::R32_SFLOAT) {
                 linear
@@ -88,16 +99,14 @@ impl SpecularTables {
         })
     }
 
-    /// Declares the six bindings of common/ks_specular.glsl, in its order: the
-    /// Beckmann and albedo tables, the region, intensity and roughness maps, the
-    /// region parameters.
+    /// Declares the five bindings of common/ks_specular.glsl, in its order: the
+    /// Beckmann and albedo tables, the region parameter, intensity and roughness maps.
     pub fn bind<'g>(&self, pass: SimplePass<'g>, inputs: &FrameInputs) -> SimplePass<'g> {
         let s = &inputs.samplers;
         pass.texture(&self.beckmann, &self.sampler)
             .texture(&self.albedo, &self.sampler)
-            .texture(&inputs.regions, &s.nearest)
+            .texture(&self.params, &s.nearest)
             .texture(&inputs.specular, &s.linear)
             .texture(&inputs.roughness, &s.linear)
-            .uniform(&self.regions)
     }
 }
