@@ -9,11 +9,13 @@ use dermis::gpu::{Context, ImageDesc, Sampler};
 use dermis::graph::upload::upload_texture;
 use dermis::graph::upload::Readback;
 use dermis::graph::{Access, Executor, Graph, Imported};
+use dermis::scene::file::Chain;
 use dermis::scene::mesh::Mesh;
 use dermis::skin::blur::{BlurChain, BlurKernel};
+use dermis::skin::chain;
 use dermis::skin::profile::{gaussian, Kernel, Profile};
-use dermis::skin::stretch::StretchPass;
-use dermis::skin::{mean_stretch, UV_FORMAT};
+use dermis::skin::stretch::StretchMaps;
+use dermis::skin::{mean_stretch, stretch_percentile, UV_FORMAT};
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -42,19 +44,31 @@ fn accurate() -> BlurKernel {
     BlurKernel::Accurate
 }
 
-/// Runs stretch + the six-level chain on `input` (N×N RGBA, alpha = coverage);
-/// returns each level normalised by its coverage (rgb / a).
-fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool) -> Vec<Vec<Vec3>> {
+/// Runs the stretch maps + the six-level chain (`full` or `adaptive`) on `input`
+/// (N×N RGBA, alpha = coverage); returns each level sampled bilinearly at the N×N
+/// texel centres, as the final pass reads it, and normalised by its coverage.
+fn chain_with(
+    mesh: &Mesh,
+    input: &[[f32; 4]],
+    kernel: &BlurKernel,
+    correction: bool,
+    variant: Chain,
+) -> Vec<Vec<Vec3>> {
     common::with_gpu(|ctx: &Arc<Context>| {
         let texels: Vec<f32> = input.iter().flatten().copied().collect();
         let bytes = common::to_f16_bytes(&texels);
         let irr = upload_texture(ctx, "input", ImageDesc::new(N, N, UV_FORMAT), &bytes).unwrap();
         let buffers = Arc::new(MeshBuffers::upload(ctx, mesh).unwrap());
-        let stretch = StretchPass::new(ctx).unwrap();
+        let profile = Profile::skin();
+        let constant = (!correction).then(|| mean_stretch(mesh, N));
+        let stretch = StretchMaps::new(ctx, N, &profile, constant).unwrap();
         let blur =
             BlurChain::new(ctx, kernel, Arc::new(Sampler::clamped(ctx, true).unwrap())).unwrap();
-        let readbacks: Vec<Readback> = (0..6)
-            .map(|_| Readback::new(ctx, "level", (N * N * 8) as u64).unwrap())
+        let texels_per_mm = constant.unwrap_or_else(|| stretch_percentile(mesh, N, 0.1));
+        let plan = chain::plan(&profile, variant, N, texels_per_mm);
+        let readbacks: Vec<Readback> = plan
+            .iter()
+            .map(|l| Readback::new(ctx, "level", (l.resolution.pow(2) * 8) as u64).unwrap())
             .collect();
         let mut g = Graph::new();
         let input = g.import_image(
@@ -63,10 +77,9 @@ fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool)
             Some(Access::ShaderSampled),
             None,
         );
-        let constant = (!correction).then(|| mean_stretch(mesh, N));
-        let st = stretch.pass(&mut g, &buffers, N, constant);
-        let levels = blur.chain(&mut g, &input, &st, &Profile::skin());
-        for (level, buf) in levels.irradiance.iter().zip(&readbacks) {
+        let st = stretch.pass(&mut g, &buffers, &blur, true);
+        let levels = blur.chain(&mut g, input, &st, &plan);
+        for (level, buf) in levels.iter().zip(&readbacks) {
             buf.image_pass(&mut g, level);
         }
         let mut ex = Executor::new(ctx, 1).unwrap();
@@ -74,20 +87,44 @@ fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool)
         ex.finish().unwrap();
         readbacks
             .iter()
-            .map(|b| {
-                common::from_f16_bytes(b.bytes().unwrap())
-                    .chunks_exact(4)
-                    .map(|p| {
-                        if p[3] > 1e-4 {
-                            Vec3::new(p[0], p[1], p[2]) / p[3]
-                        } else {
-                            Vec3::ZERO
-                        }
-                    })
-                    .collect()
+            .zip(&plan)
+            .map(|(b, l)| {
+                let level = common::from_f16_bytes(b.bytes().unwrap());
+                bilinear(&level, l.resolution)
             })
             .collect()
     })
+}
+
+fn chain(mesh: &Mesh, input: &[[f32; 4]], kernel: &BlurKernel, correction: bool) -> Vec<Vec<Vec3>> {
+    chain_with(mesh, input, kernel, correction, Chain::Full)
+}
+
+/// An RGBA level of `side`² sampled bilinearly (clamp to edge) at the centres of
+/// N×N texels, then divided by its coverage.
+fn bilinear(level: &[f32], side: u32) -> Vec<Vec3> {
+    let at = |x: i64, y: i64| {
+        let c = |t: i64| t.clamp(0, side as i64 - 1) as usize;
+        let i = 4 * (c(y) * side as usize + c(x));
+        Vec4::from_slice(&level[i..i + 4])
+    };
+    (0..N * N)
+        .map(|i| {
+            let scale = side as f32 / N as f32;
+            let fx = ((i % N) as f32 + 0.5) * scale - 0.5;
+            let fy = ((i / N) as f32 + 0.5) * scale - 0.5;
+            let (x0, y0) = (fx.floor(), fy.floor());
+            let (tx, ty) = (fx - x0, fy - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let p = (at(x0, y0) * (1.0 - tx) + at(x0 + 1, y0) * tx) * (1.0 - ty)
+                + (at(x0, y0 + 1) * (1.0 - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
+            if p.w > 1e-4 {
+                p.truncate() / p.w
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect()
 }
 
 /// Σ w_i · level_i with the skin profile's RGB weights (the paper's Fig. 2).
@@ -113,11 +150,17 @@ fn impulse(value: f32) -> Vec<[f32; 4]> {
 
 /// Max |GPU − analytic| along the row through the impulse, r ∈ [0, 3σ6], as a
 /// fraction of the analytic peak, per channel.
-fn profile_error(kernel: &BlurKernel) -> Vec3 {
+fn profile_error(kernel: &BlurKernel, variant: Chain) -> Vec3 {
     let l = 18.0; // mm: 3σ6 = 8.2 mm fits in the half-width, σ1 = 2.3 texels
     let a = l / N as f32; // mm per texel
     let p = 100.0;
-    let out = combine(&chain(&plane(l, l, 0.0, 1.0), &impulse(p), kernel, true));
+    let out = combine(&chain_with(
+        &plane(l, l, 0.0, 1.0),
+        &impulse(p),
+        kernel,
+        true,
+        variant,
+    ));
     let profile = Profile::skin();
     // The texture holds point samples: a unit sample of flux p·a² convolved with
     // the profile is the profile itself, sampled at texel centres.
@@ -145,10 +188,16 @@ fn profile_error(kernel: &BlurKernel) -> Vec3 {
 
 #[test]
 fn impulse_response_matches_the_sum_of_gaussians() {
-    let accurate = profile_error(&accurate());
-    let deon7 = profile_error(&BlurKernel::Fixed(Kernel::deon7()));
-    println!("max error / peak over r in [0, 3σ6]: accurate kernel {accurate:.4}, d'Eon 7-tap {deon7:.4}");
+    let accurate = profile_error(&accurate(), Chain::Full);
+    let deon7 = profile_error(&BlurKernel::Fixed(Kernel::deon7()), Chain::Full);
+    let adaptive = profile_error(&BlurKernel::Accurate, Chain::Adaptive);
+    println!(
+        "max error / peak over r in [0, 3σ6]: accurate kernel {accurate:.4}, d'Eon 7-tap \
+         {deon7:.4}, accurate kernel on the adaptive chain {adaptive:.4}"
+    );
     assert!(accurate.max_element() < 0.02, "accurate kernel: {accurate}");
+    // The adaptive chain (levels down to 64² here) keeps the same bound.
+    assert!(adaptive.max_element() < 0.02, "adaptive chain: {adaptive}");
 }
 
 /// World-space standard deviation (mm) of `values` along x and y.
