@@ -15,7 +15,7 @@ use dermis::skin::blur::{BlurChain, BlurKernel};
 use dermis::skin::chain;
 use dermis::skin::profile::{gaussian, Kernel, Profile};
 use dermis::skin::stretch::StretchMaps;
-use dermis::skin::{mean_stretch, stretch_percentile, UV_FORMAT};
+use dermis::skin::{mean_stretch, UV_FORMAT};
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -64,8 +64,7 @@ fn chain_with(
         let stretch = StretchMaps::new(ctx, N, &profile, constant).unwrap();
         let blur =
             BlurChain::new(ctx, kernel, Arc::new(Sampler::clamped(ctx, true).unwrap())).unwrap();
-        let texels_per_mm = constant.unwrap_or_else(|| stretch_percentile(mesh, N, 0.1));
-        let plan = chain::plan(&profile, variant, N, texels_per_mm);
+        let plan = chain::plan(&profile, variant, N, mean_stretch(mesh, N));
         let readbacks: Vec<Readback> = plan
             .iter()
             .map(|l| Readback::new(ctx, "level", (l.resolution.pow(2) * 8) as u64).unwrap())

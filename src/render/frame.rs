@@ -25,12 +25,9 @@ use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
-use crate::skin::{mean_stretch, stretch_percentile, SkinSettings};
+use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
 use std::sync::Arc;
-
-/// Surface share whose stretch the adaptive chain is planned for (skin::chain).
-const STRETCH_PERCENTILE: f32 = 0.1;
 
 /// The shadow projection of each light the frame uses (`None`: unshadowed).
 fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
@@ -198,9 +195,7 @@ impl Frame {
         )?;
         let res = skin.resolution;
         let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
-        // The adaptive chain is planned for the stretch 90 % of the surface exceeds.
-        let texels_per_mm = constant_stretch
-            .unwrap_or_else(|| stretch_percentile(&scene.mesh, res, STRETCH_PERCENTILE));
+        let texels_per_mm = mean_stretch(&scene.mesh, res);
         let levels = chain::plan(&skin.profile, skin.chain, res, texels_per_mm);
         log::info!(
             "{:?} chain at {res}² ({texels_per_mm:.2} texels/mm): levels {:?}",

@@ -9,10 +9,11 @@
 use super::profile::Profile;
 use crate::scene::file::Chain;
 
-/// Smallest total σ, in texels of its own resolution, a level is stored with.
-/// 1.5 texels keeps bilinear lookups of a Gaussian-smooth level within a few
-/// 0.1 % (measured with `dermis sweep`, docs/performance.md).
-pub const MIN_SIGMA_TEXELS: f32 = 1.5;
+/// Smallest total σ, in texels of its own resolution at the mesh's mean stretch,
+/// a level after the first is stored with: a Gaussian narrower than a texel is
+/// not reconstructed by bilinear lookups (the impulse-response test of
+/// tests/skin_diffusion.rs fails from about 0.7; docs/performance.md).
+pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 /// A first increment narrower than this (texels at the irradiance resolution) is
 /// not blurred: the level is the irradiance itself.
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
@@ -30,7 +31,7 @@ pub struct Level {
 }
 
 /// Plans the six levels. `texels_per_mm`: the stretch the adaptive choice is made
-/// for at `resolution` (skin::stretch_percentile: most of the surface has more).
+/// for at `resolution` (skin::mean_stretch).
 pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32) -> Vec<Level> {
     let mut levels = Vec::new();
     let (mut previous_variance, mut previous_resolution) = (0.0f32, resolution);
@@ -41,9 +42,11 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
                 resolution,
                 sigma_mm: Some(increment),
             },
-            Chain::Adaptive if k == 0 && increment * texels_per_mm < SKIP_SIGMA_TEXELS => Level {
+            // The first, narrowest level keeps the full resolution (d'Eon & Luebke
+            // §14.5): the irradiance itself when its blur is under SKIP_SIGMA_TEXELS.
+            Chain::Adaptive if k == 0 => Level {
                 resolution,
-                sigma_mm: None,
+                sigma_mm: (increment * texels_per_mm >= SKIP_SIGMA_TEXELS).then_some(increment),
             },
             Chain::Adaptive => {
                 let sigma = g.variance_mm2.sqrt();

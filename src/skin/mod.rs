@@ -112,35 +112,6 @@ pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
     }
 }
 
-/// Texels per millimetre at `resolution` that a fraction `1 − q` of the surface
-/// area exceeds (per triangle √(UV area in texels² / area in mm²)): the stretch the
-/// adaptive chain is planned for, so that it is fine enough almost everywhere.
-pub fn stretch_percentile(mesh: &Mesh, resolution: u32, q: f32) -> f32 {
-    let mut tris: Vec<(f32, f64)> = mesh
-        .indices
-        .chunks_exact(3)
-        .filter_map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-            let p = |i: usize| mesh.positions[i];
-            let area = 0.5 * (p(b) - p(a)).cross(p(c) - p(a)).length() as f64;
-            let (ua, ub, uc) = (mesh.uvs[a], mesh.uvs[b], mesh.uvs[c]);
-            let uv_area = 0.5 * ((ub - ua).perp_dot(uc - ua)).abs() as f64;
-            (area > 0.0 && uv_area > 0.0)
-                .then(|| (((uv_area / area).sqrt() * resolution as f64) as f32, area))
-        })
-        .collect();
-    tris.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let total: f64 = tris.iter().map(|t| t.1).sum();
-    let mut acc = 0.0;
-    for (stretch, area) in &tris {
-        acc += area;
-        if acc >= q as f64 * total {
-            return *stretch;
-        }
-    }
-    mean_stretch(mesh, resolution)
-}
-
 /// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.
 pub(crate) fn uv_pipeline(
     ctx: &Arc<Context>,
