@@ -156,6 +156,11 @@ enum Command {
         /// Print the compiled render graph (passes, barriers, lifetimes).
         #[arg(long)]
         dump_graph: bool,
+        /// Also time two ruler passes at the irradiance resolution (an RGBA16F copy,
+        /// `ruler_copy`, and a read, `ruler_read`) and report every pass's ns/texel
+        /// as a multiple of the copy's (docs/performance.md).
+        #[arg(long)]
+        ruler: bool,
     },
 }
 
@@ -309,6 +314,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             trace,
             csv,
             dump_graph,
+            ruler,
         } => {
             let file = scene_by_name(scene.as_deref())?;
             let overrides = Overrides {
@@ -335,6 +341,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 context,
                 scene_path: Some(scene.unwrap_or_else(default_scene_path)),
                 progress: std::io::stderr().is_terminal(),
+                ruler,
             })?;
             if dump_graph {
                 print!("{}", output.plan);

@@ -6,7 +6,7 @@ use super::plan::{Barrier, Plan, PoolState};
 use super::{Graph, Imported, LoadOp, ResourceKind};
 use crate::error::{Error, Result, VkResultExt};
 use crate::gpu::{full_range, Context, Image};
-use crate::profile::{FrameReport, PassTime};
+use crate::profile::{FrameReport, PassTime, PassWork};
 use ash::vk;
 use std::ffi::CString;
 use std::sync::Arc;
@@ -33,6 +33,7 @@ struct FrameSlot {
 struct InFlight {
     frame: u64,
     pass_names: Vec<String>,
+    work: Vec<PassWork>,
     cpu_record_ns: f64,
     cpu_submit_ns: f64,
     _graph: Graph,
@@ -185,8 +186,10 @@ impl Executor {
             .map(|p| p.name.clone())
             .collect();
         let n = names.len();
+        let work: Vec<PassWork> = compiled.plan.passes.iter().map(|p| p.work).collect();
         if self.clock == Clock::HostFence {
-            let report = self.run_isolated(index, &compiled, &images, &buffers, names)?;
+            let mut report = self.run_isolated(index, &compiled, &images, &buffers, names)?;
+            report.set_work(&work);
             self.frame += 1;
             return Ok(previous.or(Some(report)));
         }
@@ -198,6 +201,7 @@ impl Executor {
         self.slots[index].in_flight = Some(InFlight {
             frame: self.frame,
             pass_names: names,
+            work,
             cpu_record_ns: (recorded - started).as_nanos() as f64,
             cpu_submit_ns: (submitted - recorded).as_nanos() as f64,
             _graph: compiled.graph,
@@ -247,6 +251,7 @@ impl Executor {
                     name: name.clone(),
                     gpu_ns: Some((t3 - t1).as_nanos() as f64),
                     start_ns: Some((t1 - frame_start).as_nanos() as f64),
+                    ..Default::default()
                 });
             }
         }
@@ -325,6 +330,7 @@ impl Executor {
             // No timestamps on this device: passes are listed without GPU times.
             FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
         };
+        report.set_work(&done.work);
         report.cpu_record_ns = done.cpu_record_ns;
         report.cpu_submit_ns = done.cpu_submit_ns;
         Ok(Some(report))

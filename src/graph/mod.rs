@@ -95,6 +95,8 @@ pub(crate) type RecordFn = Box<dyn Fn(&PassCx) + Send>;
 
 pub(crate) struct PassDecl {
     pub name: String,
+    /// Texels (invocations) the pass computes; `None`: its render area, if any.
+    pub texels: Option<u64>,
     pub uses: Vec<(usize, Access)>,
     pub attachments: Vec<Attachment>,
     pub record: Option<RecordFn>,
@@ -185,6 +187,7 @@ impl Graph {
             graph: self,
             pass: PassDecl {
                 name: name.into(),
+                texels: None,
                 uses: Vec::new(),
                 attachments: Vec::new(),
                 record: None,
@@ -240,6 +243,12 @@ impl PassBuilder<'_> {
     }
 
     /// Finishes the pass with the closure that records its commands.
+    /// How many texels (invocations) the pass computes, for per-texel costs
+    /// (a graphics pass defaults to its render area).
+    pub fn texels(&mut self, texels: u64) {
+        self.pass.texels = Some(texels);
+    }
+
     pub fn record(mut self, f: impl Fn(&PassCx) + Send + 'static) {
         self.pass.record = Some(Box::new(f));
         self.graph.passes.push(self.pass);

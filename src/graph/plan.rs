@@ -4,6 +4,7 @@
 use super::{Access, Graph, ResourceKind};
 use crate::error::{Error, Result};
 use crate::gpu::ImageDesc;
+use crate::profile::PassWork;
 use ash::vk;
 use std::fmt;
 
@@ -24,6 +25,8 @@ pub struct PlannedPass {
     pub name: String,
     /// Issued as one `vkCmdPipelineBarrier2` before the pass.
     pub barriers: Vec<Barrier>,
+    /// What the pass is measured against (profile::PassWork).
+    pub work: PassWork,
 }
 
 #[derive(Clone, Debug)]
@@ -171,6 +174,35 @@ impl PoolState {
     }
 }
 
+/// The pass's texels (declared, else the render area of its first attachment) and
+/// nominal traffic: every graph resource it uses counted once at full size (an
+/// image's first mip level).
+fn work(pass: &super::PassDecl, resources: &[PlannedResource]) -> PassWork {
+    let texels = pass.texels.or_else(|| {
+        let a = pass.attachments.first()?;
+        let d = resources[a.resource].image?;
+        Some(d.width as u64 * d.height as u64)
+    });
+    let mut seen: Vec<usize> = Vec::new();
+    let mut bytes = 0;
+    for &(r, _) in &pass.uses {
+        if seen.contains(&r) {
+            continue;
+        }
+        seen.push(r);
+        let res = &resources[r];
+        bytes += match (res.image, res.buffer_size) {
+            (Some(d), _) => {
+                let texel = crate::gpu::texel_bytes(d.format).unwrap_or(0) as u64;
+                d.width as u64 * d.height as u64 * texel
+            }
+            (None, Some(size)) => size,
+            (None, None) => 0,
+        };
+    }
+    PassWork { texels, bytes }
+}
+
 impl Graph {
     /// Derives the plan. `pool` is updated only when compilation succeeds.
     pub fn compile(&self, pool: &mut PoolState) -> Result<Plan> {
@@ -207,6 +239,7 @@ impl Graph {
             passes.push(PlannedPass {
                 name: pass.name.clone(),
                 barriers,
+                work: work(pass, &resources),
             });
         }
         let mut final_barriers = Vec::new();

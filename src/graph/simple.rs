@@ -181,14 +181,19 @@ impl<'g> SimplePass<'g> {
 
     /// Dispatches enough workgroups (of the shader's reflected local size) to
     /// cover `threads` (x, y, z); 1-D and 2-D dispatches pass 1 for the rest.
-    pub fn dispatch(self, threads: [u32; 3]) {
+    pub fn dispatch(mut self, threads: [u32; 3]) {
+        self.pass
+            .texels(threads.iter().map(|&t| t as u64).product());
         let local = self.pipeline.interface.local_size;
         let groups = std::array::from_fn(|i| threads[i].div_ceil(local[i].max(1)));
         self.finish(false, move |cx| cx.dispatch(groups))
     }
 
     /// Dispatches exactly `groups` workgroups (e.g. one per row or per vertex).
-    pub fn dispatch_groups(self, groups: [u32; 3]) {
+    pub fn dispatch_groups(mut self, groups: [u32; 3]) {
+        let local = self.pipeline.interface.local_size;
+        self.pass
+            .texels((0..3).map(|i| groups[i] as u64 * local[i] as u64).product());
         self.finish(false, move |cx| cx.dispatch(groups))
     }
 

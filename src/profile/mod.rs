@@ -6,15 +6,28 @@ mod run;
 mod stats;
 pub mod trace;
 
-pub use run::{MemoryUse, PassStats, RunReport, RunSetup};
+pub use run::{MemoryUse, PassStats, RunReport, RunSetup, RULER_COPY};
 pub use stats::Stats;
 
 use serde::Serialize;
+
+/// What a pass is measured against: the texels (invocations, or pixels of its
+/// render area) it computes and its nominal memory traffic, every graph image and
+/// buffer it reads or writes counted once at full size.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct PassWork {
+    pub texels: Option<u64>,
+    pub bytes: u64,
+}
 
 /// GPU time of one pass of one frame.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct PassTime {
     pub name: String,
+    /// `None`: the pass said nothing about its size.
+    pub texels: Option<u64>,
+    /// Nominal traffic (see [`PassWork`]).
+    pub bytes: Option<u64>,
     /// `None` when the device has no timestamps or the delta was not positive.
     pub gpu_ns: Option<f64>,
     /// From the frame's start (first timestamp, or host start with host fences)
@@ -43,6 +56,18 @@ impl FrameReport {
     /// Sum of the passes' GPU times (≤ `gpu_frame_ns`: barriers and gaps are outside).
     pub fn gpu_pass_sum_ns(&self) -> f64 {
         self.passes.iter().filter_map(|p| p.gpu_ns).sum()
+    }
+
+    /// Attaches each pass's work, in pass order.
+    pub fn set_work(&mut self, work: &[PassWork]) {
+        for (p, w) in self.passes.iter_mut().zip(work) {
+            p.texels = w.texels;
+            p.bytes = Some(w.bytes);
+        }
+    }
+
+    pub fn pass(&self, name: &str) -> Option<&PassTime> {
+        self.passes.iter().find(|p| p.name == name)
     }
 
     pub fn pass_ns(&self, name: &str) -> Option<f64> {
@@ -86,6 +111,7 @@ impl FrameReport {
                 name: name.clone(),
                 gpu_ns: delta(raw.get(2 + 2 * i), raw.get(3 + 2 * i)),
                 start_ns: offset(raw.get(2 + 2 * i)),
+                ..Default::default()
             })
             .collect();
         FrameReport {
@@ -112,6 +138,8 @@ impl FrameReport {
             .iter()
             .map(|p| PassTime {
                 name: p.name.clone(),
+                texels: p.texels,
+                bytes: p.bytes,
                 gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
                 start_ns: med(frames
                     .iter()
@@ -204,6 +232,7 @@ mod tests {
                 name: "p".into(),
                 gpu_ns: Some(v),
                 start_ns: Some(v + 1.0),
+                ..Default::default()
             }],
             gpu_frame_ns: Some(v * 2.0),
             ..Default::default()

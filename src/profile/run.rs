@@ -48,8 +48,12 @@ pub struct MemoryUse {
     pub reserved_bytes: u64,
 }
 
+/// The pass whose cost per texel every other pass is compared with (render's
+/// `--ruler`: a plain RGBA16F copy at the irradiance resolution).
+pub const RULER_COPY: &str = "ruler_copy";
+
 /// One pass (or the frame span) over the measured frames.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct PassStats {
     pub name: String,
     /// Measured frames that timed it.
@@ -57,6 +61,16 @@ pub struct PassStats {
     /// `None` when no frame timed it.
     #[serde(flatten)]
     pub time: Option<Stats>,
+    /// Texels (invocations, or render-area pixels) the pass computes.
+    pub texels: Option<u64>,
+    /// Nominal traffic: each graph image and buffer it uses once at full size.
+    pub bytes: Option<u64>,
+    /// Median time per texel.
+    pub ns_per_texel: Option<f64>,
+    /// Nominal traffic over the median time (bytes per ns = GB/s).
+    pub gb_per_s: Option<f64>,
+    /// ns/texel as a multiple of the copy ruler's in the same run.
+    pub x_ruler: Option<f64>,
 }
 
 impl PassStats {
@@ -65,7 +79,22 @@ impl PassStats {
             name: name.into(),
             frames: values.iter().filter(|v| v.is_finite()).count(),
             time: Stats::of(&values),
+            ..Default::default()
         }
+    }
+
+    /// Fills the per-texel figures from the pass's work and median.
+    fn with_work(mut self, texels: Option<u64>, bytes: Option<u64>) -> Self {
+        let median = self.time.map(|t| t.median_ns).filter(|&t| t > 0.0);
+        self.texels = texels;
+        self.bytes = bytes;
+        self.ns_per_texel = median
+            .zip(texels.filter(|&t| t > 0))
+            .map(|(t, n)| t / n as f64);
+        self.gb_per_s = median
+            .zip(bytes.filter(|&b| b > 0))
+            .map(|(t, b)| b as f64 / t);
+        self
     }
 }
 
@@ -117,13 +146,22 @@ impl RunReport {
                 names.push(&p.name);
             }
         }
-        let passes = names
+        let mut passes: Vec<PassStats> = names
             .iter()
             .map(|n| {
                 let v = measured.iter().filter_map(|f| f.pass_ns(n)).collect();
+                let work = measured.iter().rev().find_map(|f| f.pass(n));
                 PassStats::of(n, v)
+                    .with_work(work.and_then(|p| p.texels), work.and_then(|p| p.bytes))
             })
             .collect();
+        let ruler = passes
+            .iter()
+            .find(|p| p.name == RULER_COPY)
+            .and_then(|p| p.ns_per_texel);
+        for p in &mut passes {
+            p.x_ruler = p.ns_per_texel.zip(ruler).map(|(a, r)| a / r);
+        }
         let spans = measured.iter().filter_map(|f| f.gpu_frame_ns).collect();
         Self {
             dermis_version: VERSION.into(),
@@ -180,12 +218,13 @@ impl RunReport {
         )
     }
 
-    /// Per pass: median, min, max, p90 over the measured frames, and their count.
+    /// Per pass: median, min, max, p90 over the measured frames, and their count;
+    /// texels, ns per texel, GB/s of nominal traffic and × the copy ruler.
     pub fn table(&self) -> String {
         let ms = |ns: Option<f64>| ns.map_or("n/a".to_string(), |v| format!("{:.3}", v / 1e6));
         let row = |name: &str, frames: usize, t: Option<Stats>| {
             format!(
-                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}\n",
+                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}",
                 name,
                 ms(t.map(|t| t.median_ns)),
                 ms(t.map(|t| t.min_ns)),
@@ -194,12 +233,23 @@ impl RunReport {
                 frames
             )
         };
-        let mut s = format!(
-            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}   (ms; clock: {})\n",
-            "pass", "median", "min", "max", "p90", "frames", self.clock
+        let opt =
+            |v: Option<f64>, digits: usize| v.map_or(String::new(), |v| format!("{v:.digits$}"));
+        let mut s =
+            format!(
+            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6} {:>10} {:>9} {:>7} {:>7}   (ms; clock: {})\n",
+            "pass", "median", "min", "max", "p90", "frames", "texels", "ns/texel", "GB/s", "×ruler",
+            self.clock
         );
         for p in &self.passes {
-            s += &row(&p.name, p.frames, p.time);
+            s += &format!(
+                "{} {:>10} {:>9} {:>7} {:>7}\n",
+                row(&p.name, p.frames, p.time),
+                p.texels.map_or(String::new(), |t| t.to_string()),
+                opt(p.ns_per_texel, 2),
+                opt(p.gb_per_s, 2),
+                opt(p.x_ruler, 2),
+            );
         }
         let sum: f64 = self
             .passes
@@ -212,6 +262,7 @@ impl RunReport {
             self.frame_span.frames,
             self.frame_span.time,
         );
+        s.push('\n');
         let measured = &self.per_frame[self.warmup_frames.min(self.per_frame.len())..];
         for (name, v) in [
             (
@@ -224,6 +275,7 @@ impl RunReport {
             ),
         ] {
             s += &row(name, v.len(), Stats::of(&v));
+            s.push('\n');
         }
         let dropped: u32 = measured.iter().map(|f| f.dropped_deltas).sum();
         if dropped > 0 {
@@ -258,11 +310,13 @@ pub(super) mod tests {
                         name: "a".into(),
                         gpu_ns: Some(a),
                         start_ns: Some(10.0),
+                        ..Default::default()
                     },
                     PassTime {
                         name: "b".into(),
                         gpu_ns: Some(5.0),
                         start_ns: Some(10.0 + a),
+                        ..Default::default()
                     },
                 ],
                 gpu_frame_ns: Some(a + 20.0),

@@ -2,6 +2,7 @@
 //! render (uploaded scene, pipelines) and the frame graph, pass by pass, for the
 //! final image or a debug view.
 
+use super::ruler::Ruler;
 use super::View;
 use crate::error::{Error, Result};
 use crate::frame::{
@@ -125,12 +126,19 @@ pub(super) struct Frame {
     skin: SkinSettings,
     /// The blur levels' resolutions (skin::chain).
     levels: Vec<Level>,
+    /// Timed beside the chain, over the irradiance (render --ruler).
+    ruler: Option<Ruler>,
     exposure: f32,
     gamma: Gamma,
 }
 
 impl Frame {
-    pub(super) fn new(ctx: &Arc<Context>, scene: &Scene, skin: SkinSettings) -> Result<Self> {
+    pub(super) fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        skin: SkinSettings,
+        ruler: bool,
+    ) -> Result<Self> {
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let samplers = Arc::new(Samplers::new(ctx)?);
         let views = shadow_views(scene);
@@ -225,6 +233,11 @@ impl Frame {
             inputs,
             skin,
             levels,
+            ruler: if ruler {
+                Some(Ruler::new(ctx, samplers.nearest.clone())?)
+            } else {
+                None
+            },
             exposure: scene.exposure(),
             gamma: scene.file.render.gamma,
         })
@@ -292,6 +305,9 @@ impl Frame {
             }
             if view == View::Irradiance {
                 return (irradiance, None);
+            }
+            if let Some(r) = &self.ruler {
+                r.passes(g, &irradiance);
             }
             let mut levels = self.blur.chain(g, irradiance, &stretch, &self.levels);
             if let View::Blur(k) = view {

@@ -5,6 +5,7 @@
 mod frame;
 pub mod output;
 mod progress;
+pub mod ruler;
 mod view;
 
 pub use view::View;
@@ -38,6 +39,8 @@ pub struct RenderOptions {
     pub scene_path: Option<PathBuf>,
     /// Show a progress bar on stderr (the caller checks it is a terminal).
     pub progress: bool,
+    /// Time the rulers (render::ruler) in every frame.
+    pub ruler: bool,
 }
 
 impl Default for RenderOptions {
@@ -50,6 +53,7 @@ impl Default for RenderOptions {
             context: ContextOptions::from_env(),
             scene_path: None,
             progress: false,
+            ruler: false,
         }
     }
 }
@@ -136,7 +140,7 @@ pub fn render_scene(
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
     let run_setup = setup(scene, opts, skin.resolution);
-    let frame = Frame::new(ctx, scene, skin)?;
+    let frame = Frame::new(ctx, scene, skin, opts.ruler)?;
     // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
     let (w, h) = {
         let (image, _) = frame.graph(&mut Graph::new(), opts.view, screen, true);
