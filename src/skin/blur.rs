@@ -116,35 +116,19 @@ impl BlurChain {
     ) {
         let tmp_desc = ImageDesc::new(dst.desc.width, src.desc.height, UV_FORMAT);
         let mut tmp = g.create_image(&format!("{name}_tmp"), tmp_desc);
-        self.pass(
-            g,
-            &format!("{name}_u"),
-            src,
-            stretch,
-            &mut tmp,
-            [1, 0],
-            sigma_mm,
-        );
-        self.pass(
-            g,
-            &format!("{name}_v"),
-            &tmp,
-            stretch,
-            dst,
-            [0, 1],
-            sigma_mm,
-        );
+        let along = |dir| BlurPush { dir, sigma_mm };
+        let u = format!("{name}_u");
+        self.pass(g, &u, (src, stretch), &mut tmp, along([1, 0]));
+        self.pass(g, &format!("{name}_v"), (&tmp, stretch), dst, along([0, 1]));
     }
 
     fn pass(
         &self,
         g: &mut Graph,
         name: &str,
-        src: &ImageHandle,
-        stretch: &ImageHandle,
+        (src, stretch): (&ImageHandle, &ImageHandle),
         dst: &mut ImageHandle,
-        dir: [i32; 2],
-        sigma_mm: f32,
+        push: BlurPush,
     ) {
         let (w, h) = (dst.desc.width, dst.desc.height);
         g.simple_pass(name, &self.pipeline)
@@ -152,7 +136,7 @@ impl BlurChain {
             .sample(stretch, &self.sampler)
             .store(dst)
             .uniform(&self.taps)
-            .constants(&BlurPush { dir, sigma_mm })
+            .constants(&push)
             .dispatch([w, h, 1]);
     }
 }
