@@ -13,6 +13,7 @@ pub mod profile;
 pub mod render;
 pub mod scene;
 pub mod skin;
+pub mod sweep;
 pub mod testscene;
 
 pub use error::{Error, Result};

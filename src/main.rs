@@ -84,6 +84,52 @@ enum Command {
         #[arg(long, value_enum)]
         occlusion: Option<Occlusion>,
     },
+    /// Time against quality: render every irradiance resolution × blur kernel ×
+    /// diffusion chain with the rulers and compare each final image and diffuse
+    /// term with a reference over the face (RMSE and max relative to the mean,
+    /// 99th percentile, PSNR). Writes sweep.csv, sweep.json, time_vs_error.{svg,png}
+    /// and passes.{svg,png} into --out-dir (docs/performance.md).
+    #[command(after_help = AFTER_HELP)]
+    Sweep {
+        /// Scene file, or `builtin`; default: assets/default.toml. Its skybox is
+        /// turned off: the face mask is the image's alpha.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Irradiance resolutions (powers of two, 256..8192), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
+        resolutions: Vec<u32>,
+        /// Blur kernels, comma-separated.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "deon7,accurate"
+        )]
+        kernels: Vec<Kernel>,
+        /// Diffusion chains, comma-separated.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "full,adaptive"
+        )]
+        chains: Vec<Chain>,
+        /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
+        #[arg(long, default_value_t = 4)]
+        frames: u32,
+        /// Irradiance resolution of the reference (accurate kernel, full chain).
+        #[arg(long, default_value_t = 4096)]
+        reference_resolution: u32,
+        /// Output width in pixels, replacing the scene's.
+        #[arg(long)]
+        width: Option<u32>,
+        /// Output height in pixels, replacing the scene's.
+        #[arg(long)]
+        height: Option<u32>,
+        /// Directory for the CSV, JSON and plots (created).
+        #[arg(long, default_value = "sweep")]
+        out_dir: PathBuf,
+    },
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
     Render {
@@ -290,6 +336,75 @@ fn run(cli: Cli) -> dermis::Result<()> {
             if timings {
                 eprint!("{}", report.table());
             }
+            Ok(())
+        }
+        Command::Sweep {
+            scene,
+            resolutions,
+            kernels,
+            chains,
+            frames,
+            reference_resolution,
+            width,
+            height,
+            out_dir,
+        } => {
+            let file = Overrides {
+                width,
+                height,
+                ..Overrides::default()
+            }
+            .apply(scene_by_name(scene.as_deref())?)?;
+            let opts = dermis::sweep::SweepOptions {
+                scene: file,
+                scene_label: scene
+                    .unwrap_or_else(default_scene_path)
+                    .display()
+                    .to_string(),
+                resolutions,
+                kernels,
+                chains,
+                frames,
+                reference_resolution,
+            };
+            dermis::sweep::validate(&opts)?;
+            std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
+                path: out_dir.display().to_string(),
+                source,
+            })?;
+            let ctx = Context::new(&context)?;
+            println!(
+                "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
+                "res",
+                "kernel",
+                "chain",
+                "frame ms",
+                "chain ms",
+                "ruler ns",
+                "final %",
+                "diffuse %",
+                "pool MiB"
+            );
+            let sweep = dermis::sweep::run(&ctx, &opts, |p| {
+                let v = p.variant;
+                println!(
+                    "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
+                    v.resolution,
+                    format!("{:?}", v.kernel).to_lowercase(),
+                    format!("{:?}", v.chain).to_lowercase(),
+                    p.total_ms,
+                    p.chain_ms,
+                    dermis::sweep::ruler_ns_per_texel(p).unwrap_or(f64::NAN),
+                    100.0 * p.final_error.rmse_rel,
+                    100.0 * p.diffuse_error.rmse_rel,
+                    p.transient_bytes as f64 / (1u64 << 20) as f64
+                );
+            })?;
+            let json = out_dir.join("sweep.json");
+            write_file(&json, &to_json(&json, &sweep)?)?;
+            write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
+            dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
+            println!("wrote {}", out_dir.display());
             Ok(())
         }
         Command::Render {

@@ -3,7 +3,7 @@
 use crate::error::Result;
 use crate::frame::{FrameInputs, HDR_FORMAT};
 use crate::gpu::{Context, GraphicsDesc, Pipeline};
-use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -29,7 +29,14 @@ impl SkyboxPass {
     }
 
     /// Clears `hdr` to the environment behind the camera.
-    pub fn pass(&self, g: &mut Graph, inputs: &FrameInputs, hdr: &mut ImageHandle) {
+    /// The environment behind everything, or (`sky` false) transparent black.
+    pub fn pass(&self, g: &mut Graph, inputs: &FrameInputs, hdr: &mut ImageHandle, sky: bool) {
+        if !sky {
+            let mut p = g.add_pass("background");
+            let r = p.write(hdr, Access::TransferDst);
+            p.record(move |cx| cx.clear_image(r, [0.0; 4]));
+            return;
+        }
         let size = [hdr.desc.width as f32, hdr.desc.height as f32];
         g.simple_pass("background", &self.pipeline)
             .uniform(&inputs.uniforms)

@@ -6,7 +6,7 @@ mod run;
 mod stats;
 pub mod trace;
 
-pub use run::{MemoryUse, PassStats, RunReport, RunSetup, RULER_COPY};
+pub use run::{MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, RULER_COPY, VERSION};
 pub use stats::Stats;
 
 use serde::Serialize;

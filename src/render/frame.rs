@@ -128,6 +128,8 @@ pub(super) struct Frame {
     levels: Vec<Level>,
     /// Timed beside the chain, over the irradiance (render --ruler).
     ruler: Option<Ruler>,
+    /// render.skybox: draw the environment behind the head.
+    skybox_on: bool,
     exposure: f32,
     gamma: Gamma,
 }
@@ -238,6 +240,7 @@ impl Frame {
             } else {
                 None
             },
+            skybox_on: scene.file.render.skybox,
             exposure: scene.exposure(),
             gamma: scene.file.render.gamma,
         })
@@ -284,7 +287,7 @@ impl Frame {
                 View::Direct => DirectView::Shading,
                 _ => DirectView::Occlusion,
             };
-            self.skybox.pass(g, &self.inputs, &mut hdr);
+            self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
             self.direct
                 .pass(g, direct, &self.inputs, &sh, &shadows, &mut hdr);
         } else {
@@ -314,7 +317,7 @@ impl Frame {
                 return (levels.swap_remove(k as usize - 1), None);
             }
             let specular_env = self.prefilter.pass(g, &self.inputs.env, first);
-            self.skybox.pass(g, &self.inputs, &mut hdr);
+            self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
             let weights: Vec<_> = self
                 .skin
                 .profile

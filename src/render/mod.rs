@@ -182,14 +182,23 @@ pub fn render_scene(
     reports.extend(executor.finish()?);
     drop(progress);
     let exposure = frame.exposure_for(opts.view);
-    // Screen views: linear radiance × 2^exposure. UV views: the values as stored.
+    // Screen views: linear radiance × 2^exposure, alpha (coverage) as is. UV
+    // views: the values as stored.
     let hdr = match &hdr_readback {
         Some(b) => {
             let scale = if uv { 1.0 } else { exposure.exp2() };
             Some(
                 b.bytes()?
                     .chunks_exact(2)
-                    .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32() * scale)
+                    .enumerate()
+                    .map(|(i, c)| {
+                        let v = half::f16::from_le_bytes([c[0], c[1]]).to_f32();
+                        if i % 4 == 3 {
+                            v
+                        } else {
+                            v * scale
+                        }
+                    })
                     .collect::<Vec<f32>>(),
             )
         }

@@ -10,7 +10,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use serde::{Deserialize, Deserializer};
+use serde::{Deserialize, Deserializer, Serialize};
 
 use super::env::{EnvSource, SkyParams};
 
@@ -294,7 +294,7 @@ fn yes() -> bool {
 }
 
 /// Blur kernel for the Gaussian chain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Kernel {
     /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in ARCHITECTURE.md).
@@ -304,7 +304,7 @@ pub enum Kernel {
 }
 
 /// At which resolutions the six Gaussians of the diffusion chain are blurred.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Chain {
     /// Every level at `render.irradiance_resolution` (GPU Gems 3 §14.5).
@@ -437,6 +437,9 @@ pub struct Render {
     /// from the environment (see `Scene::exposure`).
     pub exposure: Option<f32>,
     pub gamma: Gamma,
+    /// Draw the environment behind the head; off: transparent black, so the
+    /// image's alpha is the mesh's coverage (`dermis sweep` masks with it).
+    pub skybox: bool,
 }
 
 impl Default for Render {
@@ -448,6 +451,7 @@ impl Default for Render {
             shadow_resolution: 2048,
             exposure: None,
             gamma: Gamma::Srgb,
+            skybox: true,
         }
     }
 }
