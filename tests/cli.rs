@@ -125,7 +125,7 @@ fn render_writes_self_describing_report_trace_and_csv() {
     assert_eq!(setup["irradiance_resolution"], 256);
     assert_eq!(setup["view"], "final");
     assert_eq!(setup["kernel"], "deon7");
-    assert_eq!(setup["chain"], "full");
+    assert_eq!(setup["chain"], "adaptive");
     assert!(
         setup["scene"]
             .as_str()

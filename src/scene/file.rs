@@ -376,7 +376,7 @@ impl Default for Skin {
         Skin {
             mix: 0.5,
             kernel: Kernel::Deon7,
-            chain: Chain::Full,
+            chain: Chain::Adaptive,
             profile: None,
             regions: None,
             occlusion: Occlusion::Raytrace,
