@@ -86,3 +86,53 @@ fn host_fence_clock() {
 fn gpu_timestamp_clock() {
     check(&frames(Clock::GpuTimestamp), "gpu-timestamp");
 }
+
+/// The rulers and every pass's work: texels from the dispatch or render area,
+/// nominal bytes from the images it uses; ×ruler relative to `ruler_copy`.
+#[test]
+fn rulers_and_per_texel_figures() {
+    use dermis::render::{render_scene, RenderOptions};
+    use dermis::scene::file::{Chain, SceneFile};
+    use dermis::scene::Scene;
+    let (res, w, h) = (256u64, 64u32, 48u32);
+    let mut file = SceneFile::default();
+    file.render.irradiance_resolution = res as u32;
+    (file.render.width, file.render.height) = (w, h);
+    file.skin.chain = Chain::Full;
+    let report = |ruler| {
+        common::with_gpu(|ctx| {
+            let scene = Scene::load(file.clone()).unwrap();
+            let opts = RenderOptions {
+                frames: 2,
+                ruler,
+                ..RenderOptions::default()
+            };
+            render_scene(ctx, &scene, &opts).unwrap().report
+        })
+    };
+    let r = report(true);
+    let pass = |name: &str| r.passes.iter().find(|p| p.name == name).unwrap();
+    // The copy reads and writes one RGBA16F image of res²; the read only reads it
+    // (and writes a 1×1 sink).
+    assert_eq!(pass("ruler_copy").texels, Some(res * res));
+    assert_eq!(pass("ruler_copy").bytes, Some(2 * res * res * 8));
+    assert_eq!(pass("ruler_read").bytes, Some(res * res * 8 + 8));
+    assert_eq!(pass("ruler_copy").x_ruler, Some(1.0));
+    // A blur pass reads the level and the stretch map (≤ 1024², here res²) and
+    // writes one image.
+    let blur = pass("blur1_u");
+    assert_eq!(blur.texels, Some(res * res));
+    assert_eq!(blur.bytes, Some(3 * res * res * 8));
+    let ns = blur.time.unwrap().median_ns / (res * res) as f64;
+    assert!((blur.ns_per_texel.unwrap() - ns).abs() < 1e-9 * ns.max(1.0));
+    let copy = pass("ruler_copy").ns_per_texel.unwrap();
+    assert!((blur.x_ruler.unwrap() - ns / copy).abs() < 1e-9 * (ns / copy));
+    // Screen passes count output pixels.
+    assert_eq!(pass("skin").texels, Some(w as u64 * h as u64));
+    assert!(r.table().contains("ns/texel") && r.table().contains("×ruler"));
+    // Without the rulers nothing is relative to them.
+    let r = report(false);
+    assert!(r.passes.iter().all(|p| !p.name.starts_with("ruler_")));
+    assert!(r.passes.iter().all(|p| p.x_ruler.is_none()));
+    assert!(r.passes.iter().any(|p| p.ns_per_texel.is_some()));
+}

@@ -364,6 +364,19 @@ pub(super) mod tests {
     }
 
     #[test]
+    fn per_texel_figures_follow_from_work_and_median() {
+        let mut s =
+            PassStats::of("p", vec![2000.0, 4000.0, 3000.0]).with_work(Some(1000), Some(6000));
+        assert_eq!(s.ns_per_texel, Some(3.0));
+        assert_eq!(s.gb_per_s, Some(2.0));
+        s = s.with_work(None, Some(0));
+        assert_eq!((s.ns_per_texel, s.gb_per_s), (None, None));
+        // No time: no figures, never NaN.
+        let s = PassStats::of("q", vec![]).with_work(Some(10), Some(10));
+        assert_eq!((s.ns_per_texel, s.gb_per_s), (None, None));
+    }
+
+    #[test]
     fn statistics_leave_the_warm_up_out() {
         // Warm-up 1000, then 40 10 30 20 50: median 30, p90 rank ⌈4.5⌉ = 5 → 50.
         let r = report(&[1000.0, 40.0, 10.0, 30.0, 20.0, 50.0]);
