@@ -129,6 +129,9 @@ enum Command {
         /// Directory for the CSV, JSON and plots (created).
         #[arg(long, default_value = "sweep")]
         out_dir: PathBuf,
+        /// Render nothing: redraw the plots and CSV of --out-dir from its sweep.json.
+        #[arg(long)]
+        replot: bool,
     },
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
@@ -348,7 +351,15 @@ fn run(cli: Cli) -> dermis::Result<()> {
             width,
             height,
             out_dir,
+            replot,
         } => {
+            if replot {
+                let sweep = dermis::sweep::load(&out_dir.join("sweep.json"))?;
+                write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
+                dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
+                println!("redrew {}", out_dir.display());
+                return Ok(());
+            }
             let file = Overrides {
                 width,
                 height,

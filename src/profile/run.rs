@@ -3,7 +3,7 @@
 use super::stats::Stats;
 use super::FrameReport;
 use crate::gpu::DeviceInfo;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The dermis version the report was made by.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -53,7 +53,7 @@ pub struct MemoryUse {
 pub const RULER_COPY: &str = "ruler_copy";
 
 /// One pass (or the frame span) over the measured frames.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct PassStats {
     pub name: String,
     /// Measured frames that timed it.

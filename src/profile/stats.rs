@@ -1,9 +1,9 @@
 //! Order statistics of one quantity over frames: median, min, max, p90.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A quantity over several frames, in ns.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     /// Mean of the two middle values when the count is even.
     pub median_ns: f64,

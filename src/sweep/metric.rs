@@ -4,9 +4,9 @@
 //! mask keeps (the mesh's coverage: alpha > 0.5 with `render.skybox = false`).
 
 use crate::error::{Error, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ImageError {
     /// √(mean (a − r)²) / mean(r), over masked pixels and RGB.
     pub rmse_rel: f64,

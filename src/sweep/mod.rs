@@ -13,7 +13,7 @@ use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::file::{Chain, Kernel, SceneFile};
 use crate::scene::Scene;
 use metric::{compare, coverage_mask, ImageError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 /// What to sweep.
@@ -32,7 +32,7 @@ pub struct SweepOptions {
 }
 
 /// The resolution, kernel and chain of one render.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct Variant {
     pub resolution: u32,
     pub kernel: Kernel,
@@ -40,7 +40,7 @@ pub struct Variant {
 }
 
 /// One point of the sweep.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Point {
     #[serde(flatten)]
     pub variant: Variant,
@@ -57,7 +57,7 @@ pub struct Point {
     pub diffuse_error: ImageError,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Sweep {
     pub dermis_version: String,
     pub git_commit: String,
@@ -250,6 +250,15 @@ pub fn csv(sweep: &Sweep) -> String {
         );
     }
     out
+}
+
+/// Reads a sweep back from its `sweep.json` (to redraw the plots).
+pub fn load(path: &std::path::Path) -> Result<Sweep> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| Error::Input(format!("{}: {e}", path.display())))
 }
 
 /// The ruler's ns/texel of a point (for tables).

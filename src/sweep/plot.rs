@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// DejaVu Sans (assets/fonts, Bitstream Vera licence): PNG text needs a font file.
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-const SIZE: (u32, u32) = (1000, 640);
+const SIZE: (u32, u32) = (1200, 760);
 
 fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Input(format!("{}: {e}", path.display()))
@@ -59,15 +59,15 @@ where
 {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     area.fill(&WHITE).map_err(e)?;
-    let pts: Vec<(f64, f64)> = sweep
+    // The reference's own point (zero error) has no place on a log axis.
+    let shown: Vec<&Point> = sweep
         .points
         .iter()
-        .map(|p| {
-            (
-                p.total_ms.max(1e-3),
-                (100.0 * p.final_error.rmse_rel).max(1e-4),
-            )
-        })
+        .filter(|p| p.final_error.rmse_rel > 0.0)
+        .collect();
+    let pts: Vec<(f64, f64)> = shown
+        .iter()
+        .map(|p| (p.total_ms.max(1e-3), 100.0 * p.final_error.rmse_rel))
         .collect();
     let range = |v: Vec<f64>| {
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
@@ -93,19 +93,19 @@ where
         .configure_mesh()
         .x_labels(10)
         .y_labels(10)
+        .y_label_formatter(&|y| format!("{y:.2}"))
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .x_desc("frame time, sum of pass medians without rulers (ms)")
         .y_desc("final image RMSE / mean (%)")
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(e)?;
-    let mut labels: Vec<String> = sweep.points.iter().map(series_label).collect();
-    labels.dedup();
+    let mut labels: Vec<String> = shown.iter().map(|p| series_label(p)).collect();
     labels.sort();
     labels.dedup();
     for (i, label) in labels.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
-        let series: Vec<(f64, f64, u32)> = sweep
-            .points
+        let series: Vec<(f64, f64, u32)> = shown
             .iter()
             .zip(&pts)
             .filter(|(p, _)| &series_label(p) == label)
@@ -137,7 +137,8 @@ where
     area.present().map_err(e)
 }
 
-/// One bar per point, the medians of its passes stacked (rulers excluded).
+/// One horizontal bar per point, the medians of its passes stacked (rulers
+/// excluded), points top to bottom in sweep order.
 fn passes<DB: DrawingBackend>(sweep: &Sweep, area: DrawingArea<DB, Shift>) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -153,45 +154,42 @@ where
             groups.push(g);
         }
     }
-    let top = sweep.points.iter().map(|p| p.total_ms).fold(0.0, f64::max) * 1.1;
+    let top = sweep.points.iter().map(|p| p.total_ms).fold(0.0, f64::max) * 1.05;
     let n = sweep.points.len();
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            format!("{}: cost per pass", sweep.scene),
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(70)
-        .y_label_area_size(60)
-        .right_y_label_area_size(0)
-        .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top.max(1e-3))
-        .map_err(e)?;
+    // Row i from the top.
+    let row = |i: usize| (n - 1 - i) as f64;
     let labels: Vec<String> = sweep
         .points
         .iter()
         .map(|p| {
-            format!(
-                "{} {} {}",
-                p.variant.resolution,
-                name(&p.variant.kernel),
-                name(&p.variant.chain)
-            )
+            let v = p.variant;
+            format!("{}² {} {}", v.resolution, name(&v.kernel), name(&v.chain))
         })
         .collect();
+    let mut chart = ChartBuilder::on(&area)
+        .caption(
+            format!("{}: median per pass (ms)", sweep.scene),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(190)
+        .build_cartesian_2d(0.0..top.max(1e-3), -0.5..n as f64 - 0.5)
+        .map_err(e)?;
     chart
         .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(n + 1)
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            match (x - i).abs() < 1e-3 && i >= 0.0 {
+        .disable_y_mesh()
+        .y_labels(n + 1)
+        .y_label_formatter(&|y| {
+            let r = y.round();
+            let i = n as f64 - 1.0 - r;
+            match (y - r).abs() < 1e-3 && i >= 0.0 {
                 true => labels.get(i as usize).cloned().unwrap_or_default(),
                 false => String::new(),
             }
         })
-        .x_label_style(("sans-serif", 10))
-        .y_desc("median (ms)")
-        .label_style(("sans-serif", 12))
+        .x_desc("sum of pass medians (ms)")
+        .label_style(("sans-serif", 13))
         .draw()
         .map_err(e)?;
     for (gi, g) in groups.iter().enumerate() {
@@ -208,10 +206,10 @@ where
                         .map(|s| s.time.map_or(0.0, |t| t.median_ns) / 1e6)
                         .sum::<f64>()
                 };
-                let below = ms(&|n| groups[..gi].contains(&group(n)));
+                let left = ms(&|n| groups[..gi].contains(&group(n)));
                 let own = ms(&|n| group(n) == *g);
                 Rectangle::new(
-                    [(i as f64 - 0.35, below), (i as f64 + 0.35, below + own)],
+                    [(left, row(i) - 0.35), (left + own, row(i) + 0.35)],
                     color.filled(),
                 )
             })
@@ -224,10 +222,10 @@ where
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .label_font(("sans-serif", 11))
+        .label_font(("sans-serif", 12))
         .draw()
         .map_err(e)?;
     area.present().map_err(e)
