@@ -204,8 +204,8 @@ impl Frame {
             samplers.nearest.clone(),
         )?;
         let res = skin.resolution;
-        let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
         let texels_per_mm = mean_stretch(&scene.mesh, res);
+        let constant_stretch = (!skin.stretch_correction).then_some(texels_per_mm);
         let levels = chain::plan(&skin.profile, skin.chain, res, texels_per_mm);
         log::info!(
             "{:?} chain at {res}² ({texels_per_mm:.2} texels/mm): levels {:?}",

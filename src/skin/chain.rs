@@ -72,24 +72,24 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
     levels
 }
 
-/// Texels written by the blur passes of a plan whose input is `resolution`²
-/// (U pass: new width × old height; V pass: new side²).
-pub fn blurred_texels(levels: &[Level], resolution: u32) -> u64 {
-    let mut previous = resolution as u64;
-    let mut texels = 0;
-    for l in levels {
-        let r = l.resolution as u64;
-        if l.sigma_mm.is_some() {
-            texels += r * previous + r * r;
-        }
-        previous = r;
-    }
-    texels
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Texels written by the blur passes of a plan whose input is `resolution`²
+    /// (U pass: new width × old height; V pass: new side²).
+    fn blurred_texels(levels: &[Level], resolution: u32) -> u64 {
+        let mut previous = resolution as u64;
+        let mut texels = 0;
+        for l in levels {
+            let r = l.resolution as u64;
+            if l.sigma_mm.is_some() {
+                texels += r * previous + r * r;
+            }
+            previous = r;
+        }
+        texels
+    }
 
     #[test]
     fn the_full_chain_blurs_every_level_at_the_irradiance_resolution() {
