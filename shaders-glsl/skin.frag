@@ -53,10 +53,11 @@ void main() {
     if (dot(v_normal, v) < 0.0) n = -n;
     vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
-    // Light leaving the skin loses what the oil layer reflects toward the viewer.
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
-    vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI
-             * diffuse_transmission(n_dot_v, params);
+    // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
+    // §14.3), taken from the diffuse and given to the environment's specular.
+    float reflected = params.x * specular_albedo(n_dot_v, params.y);
+    vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * (1.0 - reflected);
     vec3 spec = vec3(0.0);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
@@ -66,7 +67,6 @@ void main() {
     // The environment's share, occluded like the diffuse by the vertex's
     // visibility (1 without occlusion).
     float visibility = OCCLUSION ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
-    spec += params.x * specular_albedo(n_dot_v, params.y)
-          * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
+    spec += reflected * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);
 }
