@@ -49,6 +49,7 @@ impl TestScene {
                     fragment: "composite.frag",
                     color_formats: &[format],
                     depth_format: None,
+                    depth_write: true,
                     vertex_layout: None,
                     cull_mode: vk::CullModeFlags::NONE,
                     specialization: &[],

@@ -13,6 +13,9 @@ pub struct GraphicsDesc<'a> {
     pub fragment: &'a str,
     pub color_formats: &'a [vk::Format],
     pub depth_format: Option<vk::Format>,
+    /// Write depth (test LESS); false: test LESS_OR_EQUAL against a depth
+    /// pre-pass of the same vertex shader, without writing.
+    pub depth_write: bool,
     /// Vertex buffer stride and (format, offset) per location; `None`: no vertex input.
     pub vertex_layout: Option<(u32, &'a [(vk::Format, u32)])>,
     pub cull_mode: vk::CullModeFlags,
@@ -201,8 +204,12 @@ impl Pipeline {
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some())
-            .depth_write_enable(desc.depth_format.is_some())
-            .depth_compare_op(vk::CompareOp::LESS);
+            .depth_write_enable(desc.depth_format.is_some() && desc.depth_write)
+            .depth_compare_op(if desc.depth_write {
+                vk::CompareOp::LESS
+            } else {
+                vk::CompareOp::LESS_OR_EQUAL
+            });
         let blend_attachments: Vec<_> = desc
             .color_formats
             .iter()

@@ -33,6 +33,7 @@ impl DirectPass {
                     fragment,
                     color_formats: &[HDR_FORMAT],
                     depth_format: Some(DEPTH_FORMAT),
+                    depth_write: true,
                     vertex_layout: Some(Vertex::layout()),
                     // Scanned meshes are not reliably closed or consistently wound.
                     cull_mode: vk::CullModeFlags::NONE,

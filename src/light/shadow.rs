@@ -96,6 +96,7 @@ impl ShadowPass {
                 fragment: "shadow.frag",
                 color_formats: &[],
                 depth_format: Some(SHADOW_FORMAT),
+                depth_write: true,
                 // Positions only.
                 vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
                 cull_mode: vk::CullModeFlags::NONE,

@@ -20,6 +20,7 @@ impl SkyboxPass {
                 fragment: "background.frag",
                 color_formats: &[HDR_FORMAT],
                 depth_format: None,
+                depth_write: true,
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &[],

@@ -61,6 +61,7 @@ impl Tonemap {
                 fragment: "tonemap.frag",
                 color_formats: &[LDR_FORMAT],
                 depth_format: None,
+                depth_write: true,
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &[],

@@ -126,6 +126,7 @@ pub(crate) fn uv_pipeline(
             fragment,
             color_formats: &[UV_FORMAT],
             depth_format: None,
+            depth_write: true,
             vertex_layout: Some(Vertex::layout()),
             // UV charts may be mirrored: both windings are surface.
             cull_mode: vk::CullModeFlags::NONE,

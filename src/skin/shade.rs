@@ -48,24 +48,36 @@ pub enum ShadeMode {
 }
 
 pub struct ShadePass {
+    /// Depth only: the pre-pass (scanned heads are two-sided and not consistently
+    /// wound, so back faces are not culled; without it their fragments are shaded
+    /// wherever they are drawn before the faces in front: ~25 % of the pass).
+    depth: Arc<Pipeline>,
     pipeline: Arc<Pipeline>,
 }
 
 impl ShadePass {
     pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex: "mesh_lit.vert",
-                fragment: "skin.frag",
-                color_formats: &[HDR_FORMAT],
-                depth_format: Some(DEPTH_FORMAT),
-                vertex_layout: Some(Vertex::layout()),
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &variant.specialization(),
-            },
-        )?;
-        Ok(Self { pipeline })
+        // The same vertex shader for both, so the shading pass's depth equals the
+        // pre-pass's exactly.
+        let mesh = |fragment, color_formats, depth_write| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    vertex: "mesh_lit.vert",
+                    fragment,
+                    color_formats,
+                    depth_format: Some(DEPTH_FORMAT),
+                    depth_write,
+                    vertex_layout: Some(Vertex::layout()),
+                    cull_mode: vk::CullModeFlags::NONE,
+                    specialization: &variant.specialization(),
+                },
+            )
+        };
+        Ok(Self {
+            depth: mesh("depth_only.frag", &[], true)?,
+            pipeline: mesh("skin.frag", &[HDR_FORMAT], false)?,
+        })
     }
 
     /// Draws the mesh over `hdr` (which holds the background).
@@ -81,6 +93,16 @@ impl ShadePass {
         let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
         let s = &inputs.samplers;
+        // mesh_lit.vert's bindings (frame 0, transfer 4) in skin.frag's order.
+        let pre = g
+            .simple_pass("skin_depth", &self.depth)
+            .uniform(&inputs.uniforms)
+            .texture(&inputs.albedo, &s.linear)
+            .texture(&inputs.normal, &s.linear)
+            .sample(images.shadows, &s.shadow)
+            .buffer(&inputs.transfer)
+            .depth(&mut depth, LoadOp::Clear([1.0; 4]));
+        inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
         // specular environment, six blur levels, the specular bindings.
         let mut pass = g
@@ -97,7 +119,7 @@ impl ShadePass {
         let pass = tables
             .bind(pass, inputs)
             .color(hdr, LoadOp::Load)
-            .depth(&mut depth, LoadOp::Clear([1.0; 4]))
+            .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {
                 weights: settings.weights.map(|w| w.extend(0.0).into()),
                 mix_pre: settings.mix,

@@ -123,6 +123,7 @@ pub fn raster_vertices(
             fragment: "occlusion_cube.frag",
             color_formats: &[vk::Format::R8_UNORM],
             depth_format: None,
+            depth_write: true,
             // Positions only.
             vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
             cull_mode: vk::CullModeFlags::NONE,
