@@ -27,10 +27,10 @@ pub struct FrameInputs {
     pub normal: Arc<Image>,
     /// Per-vertex SH transfer, 9 floats per vertex (light::occlusion).
     pub transfer: Arc<Buffer>,
-    /// Specular intensity, roughness and face-region maps (read by the specular term).
+    /// Specular intensity and roughness maps (read by the specular term; the face
+    /// regions reach it blended, skin::tables).
     pub specular: Arc<Image>,
     pub roughness: Arc<Image>,
-    pub regions: Arc<Image>,
     /// Lights, shadows, occlusion and maps the shading passes specialise on.
     pub variant: ShaderVariant,
     pub env: Arc<Image>,

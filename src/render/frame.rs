@@ -177,7 +177,6 @@ impl Frame {
             )?,
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
             roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
-            regions: upload_rgba8(ctx, "region map", &scene.regions)?,
             variant: ShaderVariant {
                 lights: scene.lights.len().min(MAX_LIGHTS) as u32,
                 occlusion: scene.file.skin.occlusion != Occlusion::Off,
