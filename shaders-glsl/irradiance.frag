@@ -1,6 +1,7 @@
 #version 460
 // Irradiance in texture space (GPU Gems 3 §14.5): SH environment irradiance
-// (Ramamoorthi & Hanrahan 2001) plus the explicit lights (shadowed), times the pre-scatter
+// (Ramamoorthi & Hanrahan 2001) plus the explicit lights (shadowed), less what the
+// specular reflects (energy conservation on entry), times the pre-scatter
 // albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
@@ -23,11 +24,12 @@ layout(location = 6) in vec3 v_t678;
 #define SPEC_REGIONS 7
 #define SPEC_INTENSITY 8
 #define SPEC_ROUGHNESS 9
+#define SPEC_HEMISPHERICAL 11
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #define SHADOW_ATLAS 10
 #include "lights.glsl"
-#define ENERGY_CONSERVING_LIGHTS
+#define ENERGY_CONSERVING
 #include "lighting.glsl"
 layout(location = 0) out vec4 irradiance;
 

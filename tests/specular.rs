@@ -16,7 +16,9 @@ use dermis::scene::file::{Occlusion, SceneFile};
 use dermis::scene::mesh::Mesh;
 use dermis::scene::texture::{Encoding, Texture};
 use dermis::scene::{Light, LightSource, Scene};
-use dermis::skin::specular::{ks_brdf, specular_albedo, DEFAULT_M, DEFAULT_RHO_S};
+use dermis::skin::specular::{
+    hemispherical_albedo, ks_brdf, map_rho_s, specular_albedo, DEFAULT_M, DEFAULT_RHO_S,
+};
 use glam::{Vec2, Vec3, Vec4};
 
 const R: f32 = 60.0; // mm
@@ -78,6 +80,12 @@ fn merge(meshes: &[Mesh]) -> Mesh {
         out.indices.extend(m.indices.iter().map(|i| i + base));
     }
     out
+}
+
+/// ρs of these scenes: d'Eon's default under a uniform specular map, raised to
+/// the middle of his range (skin::specular::map_rho_s).
+fn rho_s() -> f32 {
+    map_rho_s(DEFAULT_RHO_S, 1.0, 1.0)
 }
 
 fn scene(mesh: Mesh, lights: Vec<Light>, env: EnvMap) -> Scene {
@@ -206,7 +214,7 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
                 // Stay away from the silhouette.
                 (n.dot(v) >= 0.3).then(|| {
                     let (l, e) = light.at(p);
-                    ks_brdf(n, l, v, DEFAULT_M, DEFAULT_RHO_S) * e.x
+                    ks_brdf(n, l, v, DEFAULT_M, rho_s()) * e.x
                 })
             })
             .collect();
@@ -357,7 +365,7 @@ fn shadow_maps_shadow_the_texture_space_irradiance() {
             let n = on_sphere(uv);
             let p = n * R;
             // Energy conservation on entry: 1 − ρs·A(N·L, m).
-            let e = s.irradiance(p, n, |c| 1.0 - DEFAULT_RHO_S * albedo(c))?;
+            let e = s.irradiance(p, n, |c| 1.0 - rho_s() * albedo(c))?;
             points.push(p);
             Some(e * ALBEDO.powf(mix))
         })
@@ -385,11 +393,39 @@ fn environment_specular_is_exact_under_a_constant_environment() {
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            (cos >= 0.3).then(|| DEFAULT_RHO_S * specular_albedo(cos, DEFAULT_M) * radiance)
+            (cos >= 0.3).then(|| rho_s() * specular_albedo(cos, DEFAULT_M) * radiance)
         })
         .collect();
     let (n, _) = compare("constant environment", |i| img[i * 4], &expected);
     assert!(n > 10_000);
+}
+
+#[test]
+fn environment_enters_the_skin_less_what_the_specular_reflects() {
+    // Uniform L, no occlusion: E = π·L, of which ρs·Ā(m) is reflected
+    // (Ā = 2∫A(μ)μ dμ, the CPU quadrature), in every texel of the irradiance
+    // texture, times albedo^mix.
+    let radiance = 2.0;
+    let s = scene(
+        sphere(Vec3::ZERO, R, 96, 48, (0.0, 1.0)),
+        Vec::new(),
+        EnvMap::uniform(Vec3::splat(radiance), 64, 32),
+    );
+    let img = render(&s, View::Irradiance);
+    let want = std::f32::consts::PI
+        * radiance
+        * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M))
+        * ALBEDO.powf(s.file.skin.mix);
+    let expected: Vec<Option<f32>> = img
+        .chunks_exact(4)
+        .map(|t| (t[3] > 0.999).then_some(want))
+        .collect();
+    let (n, _) = compare("uniform environment, entry", |i| img[i * 4], &expected);
+    assert!(n > 10_000, "{n}");
+    println!(
+        "entry factor 1 − ρs·Ā = {:.4}",
+        want / (std::f32::consts::PI * radiance * ALBEDO.powf(s.file.skin.mix))
+    );
 }
 
 /// Relative errors (max over channels) of the GPU prefiltered environment of

@@ -7,7 +7,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 light_color[4];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
     mat4 light_shadow[4];   // world → (atlas u, v, depth) after the divide by w
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
-    vec4 params;            // x: exposure (EV)
+    vec4 params;            // x: exposure (EV), y: 1/(2·specular map mean) (ks_specular.glsl)
 } frame;
 // Fixed for a render (frame::ShaderVariant): the driver unrolls the light loop and
 // drops dead branches, which a CPU driver would otherwise run with masked lanes.

@@ -1,11 +1,12 @@
 // Kelemen/Szirmay-Kalos specular (the paper's eq. 1; d'Eon & Luebke, GPU Gems 3
 // §14.3, KS_Skin_Specular) with per-region parameters. Expects these bindings
 // (numbers set by the including shader through the SPEC_* macros):
-//   SPEC_BECKMANN  sampler2D  D(N·H, m), skin/specular.rs::beckmann_lut
+//   SPEC_BECKMANN  sampler2D  d'Eon's PH(N·H, m) = π·D, skin/tables.rs::beckmann_table
 //   SPEC_ALBEDO    sampler2D  A(cos θ, m), skin/specular.rs::specular_albedo_lut
 //   SPEC_REGIONS   sampler2D  (ρs, m) blended from the face regions' parameters
 //                             (skin/specular.rs::region_params_map), nearest
-//   SPEC_INTENSITY sampler2D  ρs scale (the specular map)
+//   SPEC_INTENSITY sampler2D  the specular map s; ρs·(1 + SPEC_MAP_GAIN·min(s/(2s̄), 1))
+//                             with 1/(2s̄) in frame.params.y (skin/specular.rs::map_rho_s)
 //   SPEC_ROUGHNESS sampler2D  m (grey), used when ROUGHNESS_MAP (frame.glsl)
 #include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
@@ -20,18 +21,21 @@ vec2 table_uv(sampler2D table, vec2 x) {
     return (clamp(x, 0.0, 1.0) * (n - 1.0) + 0.5) / n;
 }
 
-// (ρs, m) at uv: the face region's (soft at borders), ρs scaled by the specular
-// map, m from the roughness map where the scene gives one.
+// d'Eon's demo maps its specular map to ρs = 0.18 + 0.16·s (skin/specular.rs).
+const float SPEC_MAP_GAIN = 0.16 / 0.18;
+
+// (ρs, m) at uv: the face region's (soft at borders), ρs raised by the specular
+// map as d'Eon's rule does, m from the roughness map where the scene gives one.
 vec2 specular_params(vec2 uv) {
     vec2 params = textureLod(region_params, uv, 0.0).xy;
-    params.x *= texture(intensity_tex, uv).r;
+    params.x *= 1.0 + SPEC_MAP_GAIN * clamp(texture(intensity_tex, uv).r * frame.params.y, 0.0, 1.0);
     if (ROUGHNESS_MAP) params.y = texture(roughness_tex, uv).r;
     params.y = clamp(params.y, 0.02, 1.0);
     return params;
 }
 
-// N·L · ρs · D·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h) stands for
-// the microfacet denominator); D from the Beckmann table.
+// N·L · ρs · PH·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h) stands for
+// the microfacet denominator); PH from the table.
 float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
     float n_dot_l = dot(n, l);
     if (n_dot_l <= 0.0) return 0.0;
@@ -50,5 +54,17 @@ float specular_albedo(float cos_theta, float m) {
 // Energy conservation: the share of light at angle θ the specular does not take,
 // 1 − ρs·A(cos θ, m) (GPU Gems 3 §14.3).
 float diffuse_transmission(float cos_theta, vec2 params) {
-    return 1.0 - params.x * specular_albedo(cos_theta, params.y);
+    return max(1.0 - params.x * specular_albedo(cos_theta, params.y), 0.0);
 }
+
+#ifdef SPEC_HEMISPHERICAL
+layout(binding = SPEC_HEMISPHERICAL) uniform sampler2D hemispherical_lut;
+
+// The same for light arriving uniformly over the hemisphere, 1 − ρs·Ā(m) with
+// Ā = 2∫A(μ)μ dμ (skin/specular.rs::hemispherical_albedo): SH irradiance does
+// not keep incidence angles, so the environment is conserved as if uniform.
+float diffuse_transmission_uniform(vec2 params) {
+    vec2 uv = table_uv(hemispherical_lut, vec2(params.y, 0.0));
+    return max(1.0 - params.x * texture(hemispherical_lut, uv).r, 0.0);
+}
+#endif

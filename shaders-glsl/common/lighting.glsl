@@ -3,8 +3,9 @@
 // eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
 // explicit lights at x (geometric normal ng). Needs frame.glsl, sh.glsl,
 // lights.glsl, the Lighting buffer and v_t*.
-// With ENERGY_CONSERVING_LIGHTS (and ks_specular.glsl), each light is scaled by
-// 1 − ρs·A(N·L, m): what the specular reflects does not enter the skin.
+// With ENERGY_CONSERVING (and ks_specular.glsl with SPEC_HEMISPHERICAL),
+// each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
+// what the specular reflects does not enter the skin.
 vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
     vec3 e;
     if (OCCLUSION) {
@@ -17,11 +18,14 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
         e = sh_irradiance(lighting.sh, n);
     }
     e = max(e, vec3(0.0));
+#ifdef ENERGY_CONSERVING
+    e *= diffuse_transmission_uniform(spec_params);
+#endif
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e_light = light_irradiance(i, x, ng, l);
         float n_dot_l = max(dot(n, l), 0.0);
-#ifdef ENERGY_CONSERVING_LIGHTS
+#ifdef ENERGY_CONSERVING
         n_dot_l *= diffuse_transmission(n_dot_l, spec_params);
 #endif
         e += e_light * n_dot_l;

@@ -47,6 +47,7 @@ pub struct FrameUniforms {
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],
-    /// x: exposure (EV).
+    /// x: exposure (EV); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
+    /// (skin::specular::map_rho_s).
     pub params: [f32; 4],
 }

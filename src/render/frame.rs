@@ -24,6 +24,7 @@ use crate::skin::blur::BlurChain;
 use crate::skin::chain::{self, Level};
 use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
+use crate::skin::specular;
 use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
 use crate::skin::{mean_stretch, SkinSettings};
@@ -84,7 +85,21 @@ fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> F
                 1.0
             },
         ],
-        params: [scene.exposure(), 0.0, 0.0, 0.0],
+        params: [
+            scene.exposure(),
+            0.5 / specular::map_mean(
+                &scene.mesh.positions,
+                &scene.mesh.uvs,
+                &scene.mesh.indices,
+                (
+                    scene.specular.width,
+                    scene.specular.height,
+                    &scene.specular.rgba8,
+                ),
+            ),
+            0.0,
+            0.0,
+        ],
     };
     let tiles = views.iter().flatten().count();
     let mut tile = 0;

@@ -19,7 +19,8 @@ pub const MAX_TEXTURE_SIZE: u32 = 16384;
 pub const DEFAULT_ALBEDO_SRGB: [u8; 4] = [188, 188, 188, 255];
 /// Tangent-space (0, 0, 1): `n = 2·rgb/255 − 1`.
 pub const FLAT_NORMAL: [u8; 4] = [128, 128, 255, 255];
-/// Specular scale 1: each region's ρs is used as it is.
+/// A uniform specular map: each region's ρs raised to the middle of d'Eon's
+/// range, ×(1 + ½·0.16/0.18) (skin::specular::map_rho_s).
 pub const DEFAULT_SPECULAR: [u8; 4] = [255, 255, 255, 255];
 /// Region 0 everywhere.
 pub const DEFAULT_REGION: [u8; 4] = [0, 0, 0, 255];

@@ -54,6 +54,7 @@ impl IrradiancePass {
         let pass = tables
             .bind(pass, inputs)
             .sample(shadows, &s.shadow)
+            .texture(&tables.hemispherical, &tables.sampler)
             .color(&mut out, LoadOp::Clear([0.0; 4]))
             .constants(&mix);
         inputs.mesh.draw(pass);

@@ -12,8 +12,9 @@
 //!
 //! Conventions (see `docs/skin.md`): vectors are unit length and point away
 //! from the surface; `m` is the Beckmann RMS slope; `rho_s` is the specular
-//! intensity. [`beckmann`] is normalised (it carries the 1/π of eq. 1, which
-//! d'Eon's `PHBeckmann` listing omits).
+//! intensity. [`beckmann`] is normalised (it carries the 1/π of eq. 1); the lobe
+//! [`ks_brdf`] uses d'Eon's [`beckmann_ph`], which has no 1/π, because ρ_s = 0.18
+//! and m = 0.3 are d'Eon's values for that lobe (the calibration in `docs/skin.md`).
 
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -26,6 +27,10 @@ pub const F0_SKIN: f32 = 0.028;
 pub const DEFAULT_M: f32 = 0.3;
 /// d'Eon's default specular intensity (GPU Gems 3 §14.3).
 pub const DEFAULT_RHO_S: f32 = 0.18;
+/// How much the specular map adds to ρ_s: d'Eon's demo shader maps its map's
+/// value s to ρ_s = 0.18 + 0.16·s (GPU Gems 3 ch. 14, NVIDIA Human Head demo),
+/// i.e. ρ_s·(1 + (0.16/0.18)·s) relative to the default. See [`map_rho_s`].
+pub const SPECULAR_MAP_GAIN: f32 = 0.16 / 0.18;
 
 /// Beckmann distribution of eq. 1: D = exp(−tan²α / m²) / (π m² cos⁴α),
 /// α = acos(N·H). Normalised so that ∫ D (N·H) dω_h = 1 over the hemisphere.
@@ -56,10 +61,79 @@ fn fresnel_f64(h_dot_v: f64, f0: f64) -> f64 {
     e + f0 * (1.0 - e)
 }
 
+/// d'Eon's `PHBeckmann` (GPU Gems 3 §14.3): eq. 1 without its 1/π,
+/// exp(−tan²α / m²) / (m² cos⁴α) = π · [`beckmann`]. The lobe ρ_s = 0.18,
+/// m = 0.3 were chosen for.
+pub fn beckmann_ph(n_dot_h: f32, m: f32) -> f32 {
+    (PI * beckmann_f64(f64::from(n_dot_h), f64::from(m))) as f32
+}
+
+/// ρ_s at a point whose specular map reads `s` ∈ [0, 1], for a region of
+/// intensity `region_rho_s`: d'Eon's rule ρ_s = 0.18 + 0.16·t scaled to the
+/// region, ρ_s·(1 + [`SPECULAR_MAP_GAIN`]·t), with t = min(s / (2·s̄), 1) and s̄
+/// the map's mean over the mesh ([`map_mean`]). Normalising by s̄ puts the
+/// map's average at the middle of d'Eon's range whatever scale it was painted
+/// at (his map was made for the rule, a scan's is not); a map of one value
+/// (no map: white) gives t = ½ everywhere.
+pub fn map_rho_s(region_rho_s: f32, s: f32, s_mean: f32) -> f32 {
+    let t = (s / (2.0 * s_mean.max(1e-6))).clamp(0.0, 1.0);
+    region_rho_s * (1.0 + SPECULAR_MAP_GAIN * t)
+}
+
+/// A grey map (red channel of `rgba8`, `width` × `height`): what
+/// [`surface_average`] samples.
+pub type GreyMap<'a> = (u32, u32, &'a [u8]);
+
+/// The area-weighted mean over a mesh's surface of `f(s)`, `s` the grey map's
+/// value (nearest texel, v down) at each triangle's centroid and the midpoints
+/// of its corners and centroid. `None` for a mesh without UVs or area.
+pub fn surface_average(
+    positions: &[Vec3],
+    uvs: &[glam::Vec2],
+    indices: &[u32],
+    (width, height, rgba8): GreyMap,
+    f: impl Fn(f32) -> f32,
+) -> Option<f32> {
+    if width == 0 || height == 0 || rgba8.len() < 4 * (width * height) as usize {
+        return None;
+    }
+    let at = |uv: glam::Vec2| {
+        let x = ((uv.x.rem_euclid(1.0) * width as f32) as u32).min(width - 1);
+        let y = ((uv.y.rem_euclid(1.0) * height as f32) as u32).min(height - 1);
+        f64::from(f(f32::from(rgba8[4 * (y * width + x) as usize]) / 255.0))
+    };
+    let (mut sum, mut area) = (0.0f64, 0.0f64);
+    for t in indices.chunks_exact(3) {
+        let corner = |k: usize| Some((*positions.get(t[k] as usize)?, *uvs.get(t[k] as usize)?));
+        let (Some((p0, uv0)), Some((p1, uv1)), Some((p2, uv2))) = (corner(0), corner(1), corner(2))
+        else {
+            continue;
+        };
+        let a = f64::from((p1 - p0).cross(p2 - p0).length());
+        if !a.is_finite() {
+            continue;
+        }
+        let c = (uv0 + uv1 + uv2) / 3.0;
+        let s = at(c) + at(0.5 * (uv0 + c)) + at(0.5 * (uv1 + c)) + at(0.5 * (uv2 + c));
+        sum += a * s / 4.0;
+        area += a;
+    }
+    (area > 0.0).then(|| (sum / area) as f32)
+}
+
+/// s̄ of [`map_rho_s`]: the specular map's mean over the mesh (1 where the
+/// mesh has no UVs or the map is black).
+pub fn map_mean(positions: &[Vec3], uvs: &[glam::Vec2], indices: &[u32], map: GreyMap) -> f32 {
+    surface_average(positions, uvs, indices, map, |s| s)
+        .filter(|&s| s > 0.0)
+        .unwrap_or(1.0)
+}
+
 /// d'Eon's `KS_Skin_Specular` (GPU Gems 3 §14.3) with an analytic
-/// Beckmann term instead of the texture:
-/// h = L + V (unnormalised), H = h/|h|, f = D(N·H, m) · F(H·V, F0_SKIN) / (h·h),
-/// result = (N·L) · ρ_s · max(f, 0), and 0 where N·L ≤ 0.
+/// [`beckmann_ph`] instead of the texture:
+/// h = L + V (unnormalised), H = h/|h|, f = PH(N·H, m) · F(H·V, F0_SKIN) / (h·h),
+/// result = (N·L) · ρ_s · max(f, 0), and 0 where N·L ≤ 0. With PH = π·D this is
+/// π·ρ_s times a microfacet BRDF (below): ρ_s ≈ 0.35 is a whole dielectric lobe.
 ///
 /// The result includes the cosine N·L: it is reflected radiance per unit
 /// incident radiance from L, not the bare BRDF. The BRDF is result / (N·L).
@@ -80,7 +154,7 @@ pub fn ks_brdf(n: Vec3, l: Vec3, v: Vec3, m: f32, rho_s: f32) -> f32 {
         return 0.0;
     }
     let hn = h / hh.sqrt();
-    let ph = beckmann(n.dot(hn), m);
+    let ph = beckmann_ph(n.dot(hn), m);
     let f = fresnel_schlick(hn.dot(v), F0_SKIN);
     let fr_spec = (ph * f / hh).max(0.0);
     n_dot_l * rho_s * fr_spec
@@ -98,7 +172,8 @@ const ALBEDO_N_PHI: usize = 256;
 ///
 /// Computed in half-vector space: with u = −ln(1 − ξ), tan θ_h = m √u, φ_h
 /// uniform, H has density D(N·H)(N·H), dω_L = 4 (V·H) dω_h and h·h = 4 (V·H)²,
-/// so A = E[F(V·H) (N·L) / ((V·H)(N·H))] over L = 2(V·H)H − V with N·L > 0.
+/// so A = π·E[F(V·H) (N·L) / ((V·H)(N·H))] over L = 2(V·H)H − V with N·L > 0
+/// (π: the lobe's PH = π·D).
 /// A 1024 × 256 midpoint grid on ξ ∈ (0,1), φ ∈ (0,π) (the integrand is even
 /// in φ) is within 4e-5 of a 4096 × 1024 grid (tested; the worst case is grazing
 /// and rough, where the N·L > 0 cut-off puts a kink in the integrand).
@@ -140,7 +215,81 @@ fn albedo_f64(cos_theta: f64, m: f64, n_xi: usize, n_phi: usize) -> f64 {
             sum += fresnel_f64(v_dot_h, f0) * n_dot_l / (v_dot_h * cos_h);
         }
     }
-    sum / (n_xi * n_phi) as f64
+    PI * sum / (n_xi * n_phi) as f64
+}
+
+/// The cosine-weighted mean of [`specular_albedo`] over incidence,
+/// Ā(m) = 2∫₀¹ A(μ, m) μ dμ (128-point midpoint rule in μ): the share ρ_s·Ā of light
+/// arriving uniformly from the hemisphere that the specular reflects, which the
+/// irradiance pass takes from the environment's SH irradiance (whose incidence
+/// angles it does not know) before the light enters the skin.
+pub fn hemispherical_albedo(m: f32) -> f32 {
+    const N: usize = 128;
+    let sum: f64 = (0..N)
+        .map(|k| {
+            let mu = (k as f64 + 0.5) / N as f64;
+            albedo_f64(mu, f64::from(m), ALBEDO_N_XI / 4, ALBEDO_N_PHI / 4) * mu
+        })
+        .sum();
+    (2.0 * sum / N as f64) as f32
+}
+
+/// [`hemispherical_albedo`] at `size` endpoint-inclusive roughnesses
+/// ([`table_point`]), the irradiance pass's table.
+pub fn hemispherical_albedo_lut(size: usize) -> Vec<f32> {
+    (0..size)
+        .map(|j| hemispherical_albedo(table_point(j, size)))
+        .collect()
+}
+
+/// erf by Abramowitz & Stegun 7.1.26 (|error| ≤ 1.5e-7).
+fn erf(x: f64) -> f64 {
+    let t = 1.0 / (1.0 + 0.3275911 * x.abs());
+    let poly = t
+        * (0.254829592
+            + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+    (1.0 - poly * (-x * x).exp()).copysign(x)
+}
+
+/// Smith's Λ for the Beckmann distribution (Walter et al. 2007, eq. 25; Heitz
+/// 2014): a = cot θ / m, Λ = (erf(a) − 1)/2 + exp(−a²)/(2a√π).
+fn smith_lambda(cos_theta: f64, m: f64) -> f64 {
+    let c = cos_theta.clamp(1e-9, 1.0);
+    let a = c / (m * (1.0 - c * c).max(0.0).sqrt()).max(1e-12);
+    (erf(a) - 1.0) / 2.0 + (-a * a).exp() / (2.0 * a * PI.sqrt())
+}
+
+/// Directional albedo of a dielectric microfacet surface, the physical lobe the
+/// KS model approximates: D F G₂ / (4 (N·L)(N·V)) with the normalised Beckmann D,
+/// Schlick F at `f0` and the height-correlated Smith G₂ = 1/(1 + Λ(L) + Λ(V))
+/// (Heitz 2014), integrated over light directions on a 1024 × 512 midpoint
+/// grid in (cos θ_L, φ_L) — independently of [`specular_albedo`]'s quadrature.
+pub fn microfacet_albedo(cos_theta: f32, m: f32, f0: f32) -> f32 {
+    let (c, m, f0) = (
+        f64::from(cos_theta).clamp(1e-4, 1.0),
+        f64::from(m),
+        f64::from(f0),
+    );
+    let v = [(1.0 - c * c).sqrt(), 0.0, c];
+    let lambda_v = smith_lambda(c, m);
+    let (n_mu, n_phi) = (1024, 512);
+    let mut sum = 0.0;
+    for i in 0..n_mu {
+        let mu = (i as f64 + 0.5) / n_mu as f64;
+        let s = (1.0 - mu * mu).sqrt();
+        let g = 1.0 / (1.0 + smith_lambda(mu, m) + lambda_v);
+        for j in 0..n_phi {
+            // φ ∈ (0, π), doubled: the integrand is even in φ.
+            let phi = (j as f64 + 0.5) / n_phi as f64 * PI;
+            let l = [s * phi.cos(), s * phi.sin(), mu];
+            let h = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
+            let len = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+            let (n_dot_h, v_dot_h) = (h[2] / len, (h[0] * v[0] + h[2] * v[2]) / len);
+            let f = beckmann_f64(n_dot_h, m) * fresnel_f64(v_dot_h, f0) * g / (4.0 * mu * c);
+            sum += f * mu;
+        }
+    }
+    (sum / n_mu as f64 * (2.0 * PI / n_phi as f64)) as f32
 }
 
 /// Texel `i` of an endpoint-inclusive table of `size` entries over [0, 1]:
@@ -164,54 +313,10 @@ pub fn specular_albedo_lut(size_cos: usize, size_m: usize, n_xi: usize, n_phi: u
     lut
 }
 
-/// ρ_dt(θ, m) = 1 − A(θ, m) with ρ_s = 1 (GPU Gems 3 §14.3, energy conservation): the fraction of
-/// light from direction θ that the specular does not reflect. With a region's
-/// ρ_s, the energy-conserving diffuse factor is 1 − ρ_s · A = 1 − ρ_s (1 − ρ_dt),
-/// applied once with θ from N·L (irradiance) and once from N·V (final pass).
-pub fn rho_dt(cos_theta: f32, m: f32) -> f32 {
-    1.0 - specular_albedo(cos_theta, m)
-}
-
-/// Texel-centre coordinate of texel `i` of `size`: (i + 0.5) / size. The GPU
-/// reproduces a table entry exactly by sampling at this coordinate.
-pub fn texel_centre(i: usize, size: usize) -> f32 {
-    (i as f32 + 0.5) / size as f32
-}
-
-/// ρ_dt table, `size_cos` wide and `size_m` high, row-major:
-/// `lut[j * size_cos + i] = rho_dt(texel_centre(i, size_cos), texel_centre(j, size_m))`.
-/// As a texture: x (u) = cos θ ∈ [0, 1], y (v) = m ∈ [0, 1]; sample at
-/// uv = (cos θ, m) with linear filtering and CLAMP_TO_EDGE (see [`sample_lut`]).
-/// Store as R32F or R16F (values lie in [0, 1]).
-pub fn rho_dt_lut(size_cos: usize, size_m: usize) -> Vec<f32> {
-    let mut lut = Vec::with_capacity(size_cos * size_m);
-    for j in 0..size_m {
-        for i in 0..size_cos {
-            lut.push(rho_dt(texel_centre(i, size_cos), texel_centre(j, size_m)));
-        }
-    }
-    lut
-}
-
-/// Beckmann table in the role of d'Eon's `PHBeckmann` texture, `size` × `size`,
-/// row-major: `lut[j * size + i] = beckmann(texel_centre(i, size), texel_centre(j, size))`,
-/// x (u) = N·H, y (v) = m. Stores D itself (normalised, eq. 1), not d'Eon's
-/// 8-bit encoding 0.5 · PH^0.1; values reach 1/(π m²) ≈ 3.3e5 at size 512, so
-/// use R32F (they overflow R16F). Linear filtering in N·H is coarse for small m,
-/// where D is sharp; the analytic [`beckmann`] costs about as much as a fetch.
-pub fn beckmann_lut(size: usize) -> Vec<f32> {
-    let mut lut = Vec::with_capacity(size * size);
-    for j in 0..size {
-        for i in 0..size {
-            lut.push(beckmann(texel_centre(i, size), texel_centre(j, size)));
-        }
-    }
-    lut
-}
-
 /// Bilinear look-up in a row-major `width` × `height` table at (x, y) ∈ [0, 1]²,
 /// as a GPU sampler does with linear filtering, CLAMP_TO_EDGE and
-/// unnormalised = false: texel i's centre is at (i + 0.5) / width.
+/// unnormalised = false: texel i's centre is at (i + 0.5) / width. The shaders
+/// read an endpoint-inclusive table ([`table_point`]) at x·(n − 1)/n + ½/n.
 pub fn sample_lut(lut: &[f32], width: usize, height: usize, x: f32, y: f32) -> f32 {
     assert_eq!(lut.len(), width * height, "table size");
     let axis = |t: f32, n: usize| {
@@ -346,14 +451,16 @@ mod tests {
         assert_eq!(fresnel_schlick(1.0, F0_SKIN), F0_SKIN);
         assert_eq!(fresnel_schlick(0.0, F0_SKIN), 1.0);
         assert!((fresnel_schlick(0.5, 0.028) - (0.03125 + 0.028 * 0.96875)).abs() < 1e-7);
+        // d'Eon's PH is π·D.
+        assert!((beckmann_ph(0.9, 0.3) / beckmann(0.9, 0.3) - std::f32::consts::PI).abs() < 1e-5);
     }
 
     #[test]
     fn ks_values_by_hand() {
         let n = Vec3::Z;
-        // L = V = N: h·h = 4, D = 1/(π m²), F = F0 → N·L ρ_s F0 / (4 π m²).
+        // L = V = N: h·h = 4, PH = 1/m², F = F0 → N·L ρ_s F0 / (4 m²).
         let got = ks_brdf(n, n, n, 0.3, 1.0);
-        let want = 0.028 / (4.0 * PI * 0.09);
+        let want = 0.028 / (4.0 * 0.09);
         assert!(
             (f64::from(got) - want).abs() < 1e-6 * want,
             "{got} vs {want}"
@@ -361,7 +468,7 @@ mod tests {
         // L at 60° in xz, V = N: h·h = 3, N·H = V·H = cos 30°, N·L = 0.5.
         let l = Vec3::new(3f32.sqrt() / 2.0, 0.0, 0.5);
         let c = 3f64.sqrt() / 2.0;
-        let d = (-(1.0 / 3.0) / 0.09f64).exp() / (PI * 0.09 * c.powi(4));
+        let d = (-(1.0 / 3.0) / 0.09f64).exp() / (0.09 * c.powi(4));
         let e = (1.0 - c).powi(5);
         let f = e + 0.028 * (1.0 - e);
         let want = 0.5 * 0.18 * d * f / 3.0;
@@ -407,7 +514,7 @@ mod tests {
             }
         }
         println!("albedo: |default − 16× finer grid| ≤ {worst:.2e}");
-        assert!(worst < 5e-5);
+        assert!(worst < 2e-4);
     }
 
     #[test]
@@ -442,16 +549,20 @@ mod tests {
         assert!(worst < 1e-4);
     }
 
-    /// Max relative and absolute error of a bilinearly sampled ρ_dt table at
-    /// `count` pseudo-random points of [c_min, 1] × [m_min, 1].
-    fn lut_error(lut: &[f32], w: usize, c_min: f32, m_min: f32, count: usize) -> (f32, f32) {
+    /// Max error of the energy factor 1 − ρ_s·A read bilinearly from the
+    /// renderer's endpoint-inclusive `n`² albedo table, as the shaders read it,
+    /// at `count` pseudo-random points of [c_min, 1] × [m_min, 1]: (relative to
+    /// the factor, absolute).
+    fn table_error(n: usize, rho_s: f32, c_min: f32, m_min: f32, count: usize) -> (f32, f32) {
+        let lut = specular_albedo_lut(n, n, 256, 64);
+        let uv = |x: f32| (x * (n - 1) as f32 + 0.5) / n as f32;
         let mut rng = Lcg(42);
         let (mut rel, mut abs) = (0.0_f32, 0.0_f32);
         for _ in 0..count {
             let c = c_min + (1.0 - c_min) * rng.next();
             let m = m_min + (1.0 - m_min) * rng.next();
-            let exact = rho_dt(c, m);
-            let d = (sample_lut(lut, w, w, c, m) - exact).abs();
+            let exact = 1.0 - rho_s * specular_albedo(c, m);
+            let d = (1.0 - rho_s * sample_lut(&lut, n, n, uv(c), uv(m)) - exact).abs();
             rel = rel.max(d / exact);
             abs = abs.max(d);
         }
@@ -459,38 +570,22 @@ mod tests {
     }
 
     #[test]
-    fn rho_dt_lut_layout() {
-        let (w, h) = (8, 4);
-        let lut = rho_dt_lut(w, h);
-        assert_eq!(lut.len(), w * h);
-        let (i, j) = (5, 3);
-        assert_eq!(
-            lut[j * w + i],
-            rho_dt(texel_centre(i, w), texel_centre(j, h))
-        );
-    }
-
-    #[test]
-    fn rho_dt_lut_interpolates_within_half_a_percent() {
-        // Asserted where skin shades: N·L or N·V ≥ 0.1 and m ≥ 0.1 (32²), and
-        // ≥ 0.05 for both with 64². Nearer grazing and m → 0, ρ_dt changes too
-        // fast for a linear table; those numbers are reported only.
-        let lut32 = rho_dt_lut(32, 32);
-        let lut64 = rho_dt_lut(64, 64);
-        for (w, c_min, m_min, assert) in [
-            (32, 0.1, 0.1, true),
-            (64, 0.05, 0.05, true),
-            (32, 0.0, 0.0, false),
+    fn albedo_table_interpolates_within_half_a_percent() {
+        // The energy factor at the largest ρ_s the specular map makes of d'Eon's
+        // default. Asserted where skin shades (cos θ ≥ 0.05, m ≥ 0.1); nearer
+        // grazing and m → 0, A changes too fast for a linear table: reported only.
+        let rho_s = DEFAULT_RHO_S * (1.0 + SPECULAR_MAP_GAIN);
+        for (n, c_min, m_min, assert) in [
+            (64, 0.05, 0.1, true),
+            (32, 0.1, 0.1, false),
             (64, 0.0, 0.0, false),
-            (32, 0.02, 0.1, false),
         ] {
-            let lut = if w == 32 { &lut32 } else { &lut64 };
-            let (rel, abs) = lut_error(lut, w, c_min, m_min, 100);
+            let (rel, abs) = table_error(n, rho_s, c_min, m_min, 100);
             println!(
-                "ρdt {w}×{w} bilinear, cos ≥ {c_min}, m ≥ {m_min}: max rel {rel:.2e}, max |Δ| {abs:.2e}"
+                "1 − {rho_s:.2}·A, {n}² table, cos ≥ {c_min}, m ≥ {m_min}: max rel {rel:.2e}, max |Δ| {abs:.2e}"
             );
             if assert {
-                assert!(rel < 5e-3, "{w}²: {rel}");
+                assert!(rel < 5e-3, "{n}²: {rel}");
             }
         }
     }
@@ -500,6 +595,8 @@ mod tests {
         // Light from θ_l: specular reflects ρ_s A(θ_l); the rest enters, is
         // diffused (albedo 1, Lambertian) and leaves with the exit factor
         // 1 − ρ_s A(θ_v): its hemispherical total is 1 − ρ_s · 2∫ A(μ) μ dμ.
+        // ρ_s: d'Eon's default and the most the specular map makes of it.
+        let rho_max = DEFAULT_RHO_S * (1.0 + SPECULAR_MAP_GAIN);
         let nm = 24;
         let nmu = 64;
         let mut max_total = [0.0_f64; 2];
@@ -514,9 +611,12 @@ mod tests {
                 .enumerate()
                 .map(|(k, ak)| 2.0 * ak * (k as f64 + 0.5) / nmu as f64 / nmu as f64)
                 .sum();
-            for (slot, rho_s) in [1.0_f64, f64::from(DEFAULT_RHO_S)].iter().enumerate() {
+            for (slot, rho_s) in [f64::from(rho_max), f64::from(DEFAULT_RHO_S)]
+                .iter()
+                .enumerate()
+            {
                 for &ak in &a {
-                    assert!((0.0..=1.0).contains(&ak), "A = {ak}");
+                    assert!((0.0..=1.0).contains(&(rho_s * ak)), "ρs·A = {}", rho_s * ak);
                     max_albedo = max_albedo.max(ak);
                     let total = rho_s * ak + (1.0 - rho_s * ak) * (1.0 - rho_s * exit_mean);
                     max_total[slot] = max_total[slot].max(total);
@@ -524,24 +624,10 @@ mod tests {
             }
         }
         println!(
-            "furnace: max A = {max_albedo:.4}; max total reflectance ρs=1: {:.4}, ρs=0.18: {:.4}",
+            "furnace: max A = {max_albedo:.4}; max total reflectance ρs={rho_max:.3}: {:.4}, ρs=0.18: {:.4}",
             max_total[0], max_total[1]
         );
         assert!(max_total[0] <= 1.0 && max_total[1] <= 1.0);
-    }
-
-    #[test]
-    fn beckmann_lut_layout() {
-        let lut = beckmann_lut(16);
-        assert_eq!(lut.len(), 256);
-        assert_eq!(
-            lut[3 * 16 + 15],
-            beckmann(texel_centre(15, 16), texel_centre(3, 16))
-        );
-        assert_eq!(
-            sample_lut(&lut, 16, 16, texel_centre(4, 16), texel_centre(7, 16)),
-            lut[7 * 16 + 4]
-        );
     }
 
     #[test]
@@ -571,6 +657,89 @@ mod tests {
         // Beyond ±4 texels of the border nothing blends.
         assert!(close(at(w / 2 - 5), [0.1, 0.2]), "{:?}", at(w / 2 - 5));
         assert!(close(at(w / 2 + 4), [0.3, 0.6]), "{:?}", at(w / 2 + 4));
+    }
+
+    #[test]
+    fn microfacet_reference_by_hand() {
+        // A smooth dielectric at normal incidence reflects about F0 (G → 1).
+        let a = microfacet_albedo(1.0, 0.15, F0_SKIN);
+        assert!((a - F0_SKIN).abs() < 0.02 * F0_SKIN, "{a}");
+        // erf against tabulated values (A&S table 7.1).
+        for (x, want) in [(0.5, 0.520_499_9), (1.0, 0.842_700_8), (2.0, 0.995_322_3)] {
+            assert!((erf(x) - want).abs() < 3e-7, "erf({x}) = {}", erf(x));
+        }
+        // Λ → 0 at normal incidence; Λ(60°) for m = 0.3 is small (a = 1.92).
+        assert!(smith_lambda(1.0, 0.3) < 1e-9);
+        let l60 = smith_lambda(0.5, 0.3);
+        assert!(l60 > 0.0 && l60 < 0.01, "{l60}");
+    }
+
+    #[test]
+    fn ks_albedo_at_face_parameters_is_a_dielectric_within_30_percent() {
+        // Face-average parameters of the scan: d'Eon's region defaults raised by
+        // its specular map (map_rho_s), averaged over the mesh's surface.
+        let file = crate::scene::file::scene_by_name(None).expect("default scene");
+        let mesh = crate::scene::load_mesh(&file).expect("scan");
+        let path = file
+            .textures
+            .specular
+            .clone()
+            .expect("the scan's specular map");
+        let mut map =
+            crate::scene::texture::load_texture(&path, crate::scene::texture::Encoding::Linear)
+                .expect("specular map");
+        map.flip_vertical(); // the scan's bottom-left UV origin
+        let grey = (map.width, map.height, map.rgba8.as_slice());
+        let s_mean = map_mean(&mesh.positions, &mesh.uvs, &mesh.indices, grey);
+        let rho_s = surface_average(&mesh.positions, &mesh.uvs, &mesh.indices, grey, |s| {
+            map_rho_s(DEFAULT_RHO_S, s, s_mean)
+        })
+        .unwrap();
+        for cos in [1.0f32, 0.5] {
+            let ks = rho_s * specular_albedo(cos, DEFAULT_M);
+            let reference = microfacet_albedo(cos, DEFAULT_M, F0_SKIN);
+            println!(
+                "face-average ρs = {rho_s:.4} (s̄ = {s_mean:.3}), m = {DEFAULT_M}, cos θ = {cos}: \
+                 KS {ks:.5}, Smith dielectric {reference:.5}, ratio {:.3}",
+                ks / reference
+            );
+            assert!((ks / reference - 1.0).abs() <= 0.3, "{ks} vs {reference}");
+        }
+    }
+
+    #[test]
+    fn specular_map_rule() {
+        // d'Eon's 0.18 + 0.16·t with t = s/(2s̄): the mean maps to the middle.
+        assert!((map_rho_s(0.18, 0.3, 0.3) - 0.26).abs() < 1e-6);
+        assert!((map_rho_s(0.18, 0.0, 0.3) - 0.18).abs() < 1e-6);
+        assert!((map_rho_s(0.18, 1.0, 0.3) - 0.34).abs() < 1e-6);
+        // A uniform map of any value: t = ½.
+        let (p, uv) = (
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y],
+        );
+        let grey = [77u8, 0, 0, 255].repeat(4);
+        let mean = map_mean(&p, &uv, &[0, 1, 2], (2, 2, &grey));
+        assert!((mean - 77.0 / 255.0).abs() < 1e-6, "{mean}");
+        // No area or no UVs: 1.
+        assert_eq!(map_mean(&p, &[], &[0, 1, 2], (2, 2, &grey)), 1.0);
+    }
+
+    #[test]
+    fn hemispherical_albedo_is_the_cosine_mean() {
+        // Against a finer rule over the same A.
+        for m in [0.1f32, 0.3, 0.6] {
+            let n = 512;
+            let fine: f64 = (0..n)
+                .map(|k| {
+                    let mu = (k as f64 + 0.5) / n as f64;
+                    2.0 * f64::from(specular_albedo(mu as f32, m)) * mu / n as f64
+                })
+                .sum();
+            let a = f64::from(hemispherical_albedo(m));
+            println!("Ā(m = {m}) = {a:.5} (fine {fine:.5})");
+            assert!((a - fine).abs() < 2e-3 * fine, "{a} vs {fine}");
+        }
     }
 
     #[test]

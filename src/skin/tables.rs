@@ -18,9 +18,12 @@ use std::sync::Arc;
 pub const BECKMANN_SIZE: usize = 256;
 /// 64 × 64, as recommended by the ρdt accuracy tests (skin/specular.rs).
 pub const ALBEDO_SIZE: usize = 64;
+/// Roughnesses of the hemispherical-albedo table Ā(m) (smooth in m).
+pub const HEMISPHERICAL_SIZE: usize = 64;
 
-/// D(N·H, m) (the paper's eq. 1), endpoint-inclusive: row m = j/(n−1), column
-/// N·H = i/(n−1) (see `specular::table_point`). m = 0 is a Dirac lobe: stored as 0.
+/// d'Eon's PH(N·H, m) = π·D (specular::beckmann_ph), endpoint-inclusive: row
+/// m = j/(n−1), column N·H = i/(n−1) (see `specular::table_point`). m = 0 is a
+/// Dirac lobe: stored as 0.
 pub fn beckmann_table(n: usize) -> Vec<f32> {
     (0..n * n)
         .map(|k| {
@@ -29,7 +32,7 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
                 specular::table_point(k / n, n),
             );
             if m > 0.0 {
-                specular::beckmann(c, m)
+                specular::beckmann_ph(c, m)
             } else {
                 0.0
             }
@@ -40,6 +43,9 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
 pub struct SpecularTables {
     pub beckmann: Arc<Image>,
     pub albedo: Arc<Image>,
+    /// Ā(m), the cosine-weighted mean of A over incidence (specular::hemispherical_albedo),
+    /// for the environment's energy conservation on entry; 64 × 1.
+    pub hemispherical: Arc<Image>,
     /// (ρs, m) per region-map texel, blended across region borders
     /// (specular::region_params_map), RGBA16F.
     pub params: Arc<Image>,
@@ -55,8 +61,8 @@ impl SpecularTables {
         linear: Arc<Sampler>,
         nearest: Arc<Sampler>,
     ) -> Result<Self> {
-        let table = |name: &str, size: usize, values: Vec<f32>| {
-            let desc = ImageDesc::new(size as u32, size as u32, vk::Format::R32_SFLOAT);
+        let table = |name: &str, (w, h): (usize, usize), values: Vec<f32>| {
+            let desc = ImageDesc::new(w as u32, h as u32, vk::Format::R32_SFLOAT);
             upload_texture(ctx, name, desc, bytemuck::cast_slice(&values))
         };
         let params: Vec<[f32; 2]> = (0..REGION_COUNT)
@@ -77,13 +83,18 @@ impl SpecularTables {
         Ok(Self {
             beckmann: table(
                 "beckmann table",
-                BECKMANN_SIZE,
+                (BECKMANN_SIZE, BECKMANN_SIZE),
                 beckmann_table(BECKMANN_SIZE),
             )?,
             albedo: table(
                 "specular albedo table",
-                ALBEDO_SIZE,
+                (ALBEDO_SIZE, ALBEDO_SIZE),
                 specular::specular_albedo_lut(ALBEDO_SIZE, ALBEDO_SIZE, 256, 64),
+            )?,
+            hemispherical: table(
+                "hemispherical albedo table",
+                (HEMISPHERICAL_SIZE, 1),
+                specular::hemispherical_albedo_lut(HEMISPHERICAL_SIZE),
             )?,
             params: upload_texture(
                 ctx,
