@@ -19,6 +19,7 @@ layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
 #define SHADOW_ATLAS 5
+#define SHADOW_DEPTH 6
 #include "lights.glsl"
 #include "lighting.glsl"
 layout(location = 0) out vec4 color;

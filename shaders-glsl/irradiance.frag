@@ -28,6 +28,7 @@ layout(location = 6) in vec3 v_t678;
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #define SHADOW_ATLAS 10
+#define SHADOW_DEPTH 12
 #include "lights.glsl"
 #define ENERGY_CONSERVING
 #include "lighting.glsl"

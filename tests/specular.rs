@@ -192,11 +192,13 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
             source: LightSource::Directional(Vec3::new(0.4, 0.5, 1.0).normalize()),
             irradiance: Vec3::splat(200.0),
             shadow: true,
+            angular_radius: 0.0,
         },
         Light {
             source: LightSource::Point(Vec3::new(-150.0, -60.0, 180.0)),
             irradiance: Vec3::splat(20.0),
             shadow: false,
+            angular_radius: 0.0,
         },
     ];
     for light in lights {
@@ -254,11 +256,13 @@ impl ShadowScene {
                 source: LightSource::Directional(dir),
                 irradiance: Vec3::splat(3.0),
                 shadow: true,
+                angular_radius: 0.0,
             },
             Light {
                 source: LightSource::Point(point),
                 irradiance: Vec3::splat(0.6),
                 shadow: true,
+                angular_radius: 0.0,
             },
         ];
         let mesh = merge(&[

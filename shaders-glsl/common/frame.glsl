@@ -3,11 +3,12 @@ layout(std140, binding = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
     vec4 camera_pos;        // xyz mm
-    vec4 light_vec[4];      // w 0: xyz direction towards the light; w 1: xyz position, mm
-    vec4 light_color[4];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
-    mat4 light_shadow[4];   // world → (atlas u, v, depth) after the divide by w
+    vec4 light_vec[8];      // w 0: xyz direction towards the light; w 1: xyz position, mm
+    vec4 light_color[8];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
+    mat4 light_shadow[8];   // world → (atlas u, v, depth) after the divide by w
+    vec4 light_params[8];   // x: tan(angular radius), y: shadow depth range mm, z: m² widening
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
-    vec4 params;            // x: exposure (EV), y: 1/(2·specular map mean) (ks_specular.glsl)
+    vec4 params;            // x: exposure (EV), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;
 // Fixed for a render (frame::ShaderVariant): the driver unrolls the light loop and
 // drops dead branches, which a CPU driver would otherwise run with masked lanes.
@@ -15,3 +16,4 @@ layout(constant_id = 0) const int LIGHT_COUNT = 0;
 layout(constant_id = 1) const bool OCCLUSION = true;
 layout(constant_id = 2) const bool ROUGHNESS_MAP = false;
 layout(constant_id = 3) const int SHADOWED_LIGHTS = 0;   // bit i: light i has a shadow map
+layout(constant_id = 4) const int SOFT_LIGHTS = 0;       // bit i: light i has an angular size

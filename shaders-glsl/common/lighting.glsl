@@ -26,7 +26,7 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
         vec3 e_light = light_irradiance(i, x, ng, l);
         float n_dot_l = max(dot(n, l), 0.0);
 #ifdef ENERGY_CONSERVING
-        n_dot_l *= diffuse_transmission(n_dot_l, spec_params);
+        n_dot_l *= diffuse_transmission(n_dot_l, light_lobe(i, spec_params));
 #endif
         e += e_light * n_dot_l;
     }

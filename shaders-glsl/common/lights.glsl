@@ -1,7 +1,11 @@
 // The explicit lights of frame.glsl: directional, or point with 1/d² falloff, each
-// optionally shadowed by its tile of the shadow atlas (light/shadow.rs), read with
-// 3×3 bilinear PCF. Expects SHADOW_ATLAS: the atlas's binding.
+// optionally shadowed by its tile of the shadow atlas (light/shadow.rs). Point-like
+// lights are read with 3×3 bilinear PCF; lights with an angular size (the sources
+// extracted from the environment) with percentage-closer soft shadows, so the
+// penumbra follows the source's size. Expects SHADOW_ATLAS and SHADOW_DEPTH: the
+// atlas's bindings, with a depth-comparison and a plain nearest sampler.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
+layout(binding = SHADOW_DEPTH) uniform sampler2D shadow_depth;
 
 const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 // Acne offsets, in shadow-map texels: along the normal (normal-offset shadows,
@@ -10,6 +14,55 @@ const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 // then stays behind the lookup point when the normal offset is ≥ 2·sin θ texels.
 const float NORMAL_OFFSET_TEXELS = 2.5;
 const float LIGHT_OFFSET_TEXELS = 1.0;
+// Soft shadows (Fernando 2005, PCSS): taps of the blocker search and of the
+// filter, on a Vogel (golden-angle) disk turned per pixel; the filter's radius is
+// clamped to what those taps can cover without gaps turning into bands.
+const int BLOCKER_TAPS = 12;
+const int PCF_TAPS = 16;
+const float MAX_SOFT_TEXELS = 48.0;
+
+// Interleaved gradient noise (Jimenez 2014): a per-pixel angle in [0, 2π).
+float soft_shadow_angle() {
+    return 6.2831853 * fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+}
+
+// Tap k of n on a unit Vogel disk turned by phi (radius √((k + ½)/n)).
+vec2 vogel_tap(int k, int n, float phi) {
+    float a = float(k) * 2.39996323 + phi;
+    return sqrt((float(k) + 0.5) / float(n)) * vec2(cos(a), sin(a));
+}
+
+// Fraction of a source of angular radius atan(tan_r) that reaches the atlas
+// point s (u, v, depth): blockers found within the reach of the source's cone
+// give the penumbra's radius (receiver − blocker distance)·tan r.
+float soft_visibility(int i, vec3 s, vec2 step) {
+    float tan_r = frame.light_params[i].x;
+    float range = frame.light_params[i].y;
+    float texel = frame.light_color[i].w;
+    // Taps stay inside this light's tile of the atlas.
+    vec2 tiles = frame.params.zw;
+    vec2 lo = floor(s.xy * tiles) / tiles + 0.5 * step;
+    vec2 hi = lo + 1.0 / tiles - step;
+    float phi = soft_shadow_angle();
+    float search = clamp(s.z * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
+    float blockers = 0.0, count = 0.0;
+    for (int k = 0; k < BLOCKER_TAPS; ++k) {
+        vec2 p = clamp(s.xy + vogel_tap(k, BLOCKER_TAPS, phi) * search * step, lo, hi);
+        float z = textureLod(shadow_depth, p, 0.0).r;
+        if (z < s.z) {
+            blockers += z;
+            count += 1.0;
+        }
+    }
+    if (count == 0.0) return 1.0;
+    float radius = clamp((s.z - blockers / count) * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
+    float lit = 0.0;
+    for (int k = 0; k < PCF_TAPS; ++k) {
+        vec2 p = clamp(s.xy + vogel_tap(k, PCF_TAPS, phi + 1.0) * radius * step, lo, hi);
+        lit += texture(shadow_atlas, vec3(p, s.z));
+    }
+    return lit / float(PCF_TAPS);
+}
 
 // Fraction of light i that reaches x (surface normal ng) from direction l.
 float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
@@ -20,6 +73,7 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     s.xyz /= s.w;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
     vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
+    if ((SOFT_LIGHTS & (1 << i)) != 0) return soft_visibility(i, s.xyz, step);
     float lit = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -46,4 +100,10 @@ vec3 light_irradiance(int i, vec3 x, vec3 ng, out vec3 l) {
     }
     if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, l, dist);
     return e;
+}
+
+// The specular lobe's (ρs, m) for light i: a source of angular size widens it,
+// m² + light_params.z (light/shadow.rs::lobe_widening).
+vec2 light_lobe(int i, vec2 params) {
+    return vec2(params.x, sqrt(params.y * params.y + frame.light_params[i].z));
 }

@@ -1,7 +1,8 @@
 //! The per-frame uniform block (std140, mirrors shaders-glsl/common/frame.glsl).
 
-/// Lights the frame's shaders loop over (common/lights.glsl).
-pub const MAX_LIGHTS: usize = 4;
+/// Lights the frame's shaders loop over (common/lights.glsl): the scene's
+/// explicit lights, then the sources extracted from the environment.
+pub const MAX_LIGHTS: usize = 8;
 
 /// What stays fixed for a whole render and selects code in the shading passes:
 /// their specialization constants (shaders-glsl/common/frame.glsl). Fixed loop
@@ -17,16 +18,20 @@ pub struct ShaderVariant {
     pub roughness_map: bool,
     /// Bit i: light i has a shadow map.
     pub shadowed: u32,
+    /// Bit i: light i has an angular size, so its shadow has a penumbra
+    /// (percentage-closer soft shadows, common/lights.glsl).
+    pub soft: u32,
 }
 
 impl ShaderVariant {
-    /// `constant_id` 0..=3 of frame.glsl.
-    pub fn specialization(&self) -> [u32; 4] {
+    /// `constant_id` 0..=4 of frame.glsl.
+    pub fn specialization(&self) -> [u32; 5] {
         [
             self.lights,
             u32::from(self.occlusion),
             u32::from(self.roughness_map),
             self.shadowed,
+            self.soft,
         ]
     }
 }
@@ -44,10 +49,14 @@ pub struct FrameUniforms {
     pub light_color: [[f32; 4]; MAX_LIGHTS],
     /// World to (atlas u, v, depth), light::shadow::ShadowView::atlas_matrix.
     pub light_shadow: [[[f32; 4]; 4]; MAX_LIGHTS],
+    /// x: tan of the source's angular radius (0: a point); y: the shadow map's
+    /// depth range, mm (directional lights); z: what the source adds to the
+    /// specular lobe's m² (light::shadow::lobe_widening); w: 0.
+    pub light_params: [[f32; 4]; MAX_LIGHTS],
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],
     /// x: exposure (EV); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
-    /// (skin::specular::map_rho_s).
+    /// (skin::specular::map_rho_s); z, w: the shadow atlas's tile columns and rows.
     pub params: [f32; 4],
 }

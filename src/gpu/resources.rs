@@ -242,7 +242,8 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    /// Clamp-to-edge sampler; `linear` picks bilinear filtering, else nearest.
+    /// Clamp-to-edge sampler; `linear` picks trilinear filtering, else nearest
+    /// (texels and mip levels).
     pub fn clamped(ctx: &Arc<Context>, linear: bool) -> Result<Self> {
         Self::new(ctx, linear, None)
     }
@@ -255,15 +256,15 @@ impl Sampler {
     }
 
     fn new(ctx: &Arc<Context>, linear: bool, compare: Option<vk::CompareOp>) -> Result<Self> {
-        let filter = if linear {
-            vk::Filter::LINEAR
+        let (filter, mipmap) = if linear {
+            (vk::Filter::LINEAR, vk::SamplerMipmapMode::LINEAR)
         } else {
-            vk::Filter::NEAREST
+            (vk::Filter::NEAREST, vk::SamplerMipmapMode::NEAREST)
         };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(filter)
             .min_filter(filter)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .mipmap_mode(mipmap)
             .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)

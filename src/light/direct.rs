@@ -73,6 +73,7 @@ impl DirectPass {
             .read_uniform(sh)
             .buffer(&inputs.transfer)
             .sample(shadows, &s.shadow)
+            .sample(shadows, &s.nearest)
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pass);

@@ -1,7 +1,7 @@
 //! Shadow maps for the explicit lights (GPU Gems 3 §14.4.1 shadows the irradiance
 //! pass with them): the mesh's depth seen from each shadowed light, one square tile
-//! per light side by side in one D32 atlas, read with 3×3 bilinear PCF by
-//! shaders-glsl/common/lights.glsl.
+//! per light in a grid in one D32 atlas, read by shaders-glsl/common/lights.glsl
+//! with 3×3 bilinear PCF, or for a source of angular size with soft shadows.
 
 use crate::error::Result;
 use crate::frame::{MeshBuffers, Vertex, SHADOW_FORMAT};
@@ -25,6 +25,27 @@ pub struct ShadowView {
     /// World size of one texel, mm: constant for a directional light; for a point
     /// light, per mm of distance from it. The shaders' acne offsets scale with it.
     pub texel_mm: f32,
+    /// Depth range of the map, mm (far − near; depth is linear for a directional
+    /// light), which the soft shadows turn blocker depths into distances with.
+    pub depth_range_mm: f32,
+}
+
+/// Columns and rows of the atlas's grid of `tiles` square tiles: ⌊√n⌋ rows,
+/// as many columns as they need (8 lights: 4 × 2, no tile wasted).
+pub fn atlas_grid(tiles: usize) -> (u32, u32) {
+    let n = tiles.max(1);
+    let rows = (n as f64).sqrt().floor() as usize;
+    (n.div_ceil(rows) as u32, rows as u32)
+}
+
+/// What a source of angular radius `r` (radians) adds to the Beckmann lobe's
+/// m² when its light is treated as a direction: the reflected direction spreads
+/// over a disc of radius r, the half vector over r/2, a disc of slopes tan(r/2)
+/// whose mean squared slope, tan²(r/2)/2, adds to m² (the variance of a
+/// convolution is the sum). D stays normalised, so the energy does not change.
+pub fn lobe_widening(r: f32) -> f32 {
+    let t = (0.5 * r).tan();
+    0.5 * t * t
 }
 
 impl ShadowView {
@@ -50,6 +71,7 @@ impl ShadowView {
                 Some(Self {
                     view_proj: proj * view,
                     texel_mm: 2.0 * r / res,
+                    depth_range_mm: 2.0 * r,
                 })
             }
             LightSource::Point(p) => {
@@ -63,20 +85,23 @@ impl ShadowView {
                 Some(Self {
                     view_proj: proj * view,
                     texel_mm: 2.0 * half.tan() / res,
+                    depth_range_mm: 2.0 * r,
                 })
             }
         }
     }
 
     /// World to (atlas u, v, depth) after the divide by w, for tile `tile` of
-    /// `tiles` laid out left to right.
+    /// `tiles` laid out row by row in the [`atlas_grid`].
     pub fn atlas_matrix(&self, tile: usize, tiles: usize) -> Mat4 {
-        let n = tiles as f32;
+        let (cols, rows) = atlas_grid(tiles);
+        let (c, r) = (cols as f32, rows as f32);
+        let (col, row) = ((tile as u32 % cols) as f32, (tile as u32 / cols) as f32);
         let bias = Mat4::from_cols(
-            Vec4::new(0.5 / n, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, 0.5, 0.0, 0.0),
+            Vec4::new(0.5 / c, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, 0.5 / r, 0.0, 0.0),
             Vec4::new(0.0, 0.0, 1.0, 0.0),
-            Vec4::new((0.5 + tile as f32) / n, 0.5, 0.0, 1.0),
+            Vec4::new((0.5 + col) / c, (0.5 + row) / r, 0.0, 1.0),
         );
         bias * self.view_proj
     }
@@ -116,9 +141,10 @@ impl ShadowPass {
         views: &[ShadowView],
         resolution: u32,
     ) -> ImageHandle {
-        let (w, h) = match views.len() as u32 {
+        let (cols, rows) = atlas_grid(views.len());
+        let (w, h) = match views.len() {
             0 => (1, 1),
-            n => (n * resolution, resolution),
+            _ => (cols * resolution, rows * resolution),
         };
         let mut atlas = g.create_image("shadow atlas", ImageDesc::new(w, h, SHADOW_FORMAT));
         let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
@@ -127,7 +153,8 @@ impl ShadowPass {
             .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
             .record(move |cx| {
                 for (i, m) in matrices.iter().enumerate() {
-                    cx.set_viewport(i as u32 * resolution, 0, resolution, resolution);
+                    let (col, row) = (i as u32 % cols, i as u32 / cols);
+                    cx.set_viewport(col * resolution, row * resolution, resolution, resolution);
                     cx.push_constants(&pipe, m);
                     mesh.record_draw(cx);
                 }
@@ -152,15 +179,18 @@ mod tests {
             LightSource::Directional(Vec3::Y),
             LightSource::Point(c + Vec3::new(300.0, 100.0, 400.0)),
         ];
-        for (tile, light) in lights.into_iter().enumerate() {
+        for (k, light) in lights.into_iter().enumerate() {
             let v = ShadowView::fit(light, c, r, 1024).unwrap();
-            let m = v.atlas_matrix(tile, 3);
+            // Tiles 0, 2 and 4 of five: a 3 × 2 grid, tile 4 on the second row.
+            let tile = 2 * k;
+            let m = v.atlas_matrix(tile, 5);
+            let (col, row) = ((tile % 3) as f32, (tile / 3) as f32);
             // Points on the sphere land in this tile with depth in (0, 1).
             for dir in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
                 let s = project(m, c + dir * r);
-                let u = s.x * 3.0 - tile as f32;
+                let (u, w) = (s.x * 3.0 - col, s.y * 2.0 - row);
                 assert!(
-                    u > 0.0 && u < 1.0 && s.y > 0.0 && s.y < 1.0,
+                    u > 0.0 && u < 1.0 && w > 0.0 && w < 1.0,
                     "{light:?} {dir} {s}"
                 );
                 assert!(s.z > 0.0 && s.z < 1.0, "{light:?} {dir} {s}");
@@ -174,5 +204,34 @@ mod tests {
             assert!(project(m, c).z < project(m, c - towards * r).z);
         }
         assert!(ShadowView::fit(LightSource::Point(c), c, r, 1024).is_none());
+    }
+
+    #[test]
+    fn atlas_grids_are_nearly_square() {
+        let grids: Vec<_> = (0..=8).map(atlas_grid).collect();
+        assert_eq!(
+            grids,
+            [
+                (1, 1),
+                (1, 1),
+                (2, 1),
+                (3, 1),
+                (2, 2),
+                (3, 2),
+                (3, 2),
+                (4, 2),
+                (4, 2)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_source_widens_the_lobe_by_its_slope_variance() {
+        // The sun (0.53° across) adds nothing visible to m = 0.3; a 20° softbox
+        // adds tan²(5°)/2.
+        assert!(lobe_widening(0.265f32.to_radians()) < 1e-5);
+        let t = 5f32.to_radians().tan();
+        assert!((lobe_widening(10f32.to_radians()) - 0.5 * t * t).abs() < 1e-7);
+        assert_eq!(lobe_widening(0.0), 0.0);
     }
 }

@@ -15,11 +15,11 @@ use crate::graph::{Access, Graph, ImageHandle};
 use crate::light::direct::{DirectPass, DirectView};
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
-use crate::light::shadow::{ShadowPass, ShadowView};
+use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
 use crate::light::skybox::SkyboxPass;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::scene::file::{Gamma, Occlusion};
-use crate::scene::{LightSource, Scene};
+use crate::scene::{Light, LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::chain::{self, Level};
 use crate::skin::irradiance::IrradiancePass;
@@ -31,21 +31,24 @@ use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
 use std::sync::Arc;
 
-/// The shadow projection of each light the frame uses (`None`: unshadowed).
-fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
-    let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
-    let (centre, radius) = (0.5 * (lo + hi), 0.5 * lo.distance(hi));
-    let res = scene.file.render.shadow_resolution;
+/// The lights the frame uses: the scene's, at most [`MAX_LIGHTS`].
+fn frame_lights(scene: &Scene) -> Vec<Light> {
     if scene.lights.len() > MAX_LIGHTS {
         log::warn!(
             "only the first {MAX_LIGHTS} of {} lights are used",
             scene.lights.len()
         );
     }
-    scene
-        .lights
+    scene.lights.iter().take(MAX_LIGHTS).copied().collect()
+}
+
+/// The shadow projection of each light (`None`: unshadowed).
+fn shadow_views(scene: &Scene, lights: &[Light]) -> Vec<Option<ShadowView>> {
+    let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
+    let (centre, radius) = (0.5 * (lo + hi), 0.5 * lo.distance(hi));
+    let res = scene.file.render.shadow_resolution;
+    lights
         .iter()
-        .take(MAX_LIGHTS)
         .map(|l| {
             let view = l
                 .shadow
@@ -65,9 +68,15 @@ fn shadow_views(scene: &Scene) -> Vec<Option<ShadowView>> {
 
 /// The frame's uniforms: camera, environment rotation and intensity, lights and
 /// their shadow projections (`views`, from [`shadow_views`]), exposure.
-fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> FrameUniforms {
+fn frame_uniforms(
+    scene: &Scene,
+    lights: &[Light],
+    aspect: f32,
+    views: &[Option<ShadowView>],
+) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let env = &scene.file.environment;
+    let tiles = views.iter().flatten().count();
     let mut u = FrameUniforms {
         view_proj: vp.to_cols_array_2d(),
         inv_view_proj: vp.inverse().to_cols_array_2d(),
@@ -75,6 +84,7 @@ fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> F
         light_vec: [[0.0; 4]; MAX_LIGHTS],
         light_color: [[0.0; 4]; MAX_LIGHTS],
         light_shadow: [[[0.0; 4]; 4]; MAX_LIGHTS],
+        light_params: [[0.0; 4]; MAX_LIGHTS],
         env: [
             env.rotation_deg.to_radians(),
             env.intensity,
@@ -97,22 +107,24 @@ fn frame_uniforms(scene: &Scene, aspect: f32, views: &[Option<ShadowView>]) -> F
                     &scene.specular.rgba8,
                 ),
             ),
-            0.0,
-            0.0,
+            atlas_grid(tiles).0 as f32,
+            atlas_grid(tiles).1 as f32,
         ],
     };
-    let tiles = views.iter().flatten().count();
     let mut tile = 0;
-    for (i, (l, view)) in scene.lights.iter().zip(views).enumerate() {
+    for (i, (l, view)) in lights.iter().zip(views).enumerate() {
         u.light_vec[i] = match l.source {
             LightSource::Directional(d) => d.extend(0.0),
             LightSource::Point(p) => p.extend(1.0),
         }
         .into();
         u.light_color[i] = l.irradiance.extend(0.0).into();
+        u.light_params[i][0] = l.angular_radius.tan();
+        u.light_params[i][2] = lobe_widening(l.angular_radius);
         if let Some(v) = view {
             u.light_color[i][3] = v.texel_mm;
             u.light_shadow[i] = v.atlas_matrix(tile, tiles).to_cols_array_2d();
+            u.light_params[i][1] = v.depth_range_mm;
             tile += 1;
         }
         u.env[2] = (i + 1) as f32;
@@ -158,15 +170,23 @@ impl Frame {
     ) -> Result<Self> {
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let samplers = Arc::new(Samplers::new(ctx)?);
-        let views = shadow_views(scene);
+        let lights = frame_lights(scene);
+        let views = shadow_views(scene, &lights);
         let shadow_res = scene.file.render.shadow_resolution;
-        let tiles = views.iter().flatten().count() as u32;
-        super::check_target(&ctx.info, shadow_res * tiles.max(1), shadow_res).map_err(|e| {
+        let tiles = views.iter().flatten().count();
+        let (cols, rows) = atlas_grid(tiles);
+        super::check_target(&ctx.info, shadow_res * cols, shadow_res * rows).map_err(|e| {
             Error::Input(format!(
                 "shadow atlas of {tiles} light(s) at render.shadow_resolution = {shadow_res}: {e}"
             ))
         })?;
-        let uniforms = frame_uniforms(scene, w as f32 / h as f32, &views);
+        let uniforms = frame_uniforms(scene, &lights, w as f32 / h as f32, &views);
+        // Bit i set where light i has `has`.
+        let bits = |has: &dyn Fn(usize) -> bool| {
+            (0..lights.len())
+                .filter(|&i| has(i))
+                .fold(0, |b, i| b | 1 << i)
+        };
         let inputs = FrameInputs {
             uniforms: upload_buffer(
                 ctx,
@@ -193,14 +213,16 @@ impl Frame {
             specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
             roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
             variant: ShaderVariant {
-                lights: scene.lights.len().min(MAX_LIGHTS) as u32,
+                lights: lights.len() as u32,
                 occlusion: scene.file.skin.occlusion != Occlusion::Off,
                 roughness_map: scene.file.textures.roughness.is_some(),
-                shadowed: views
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, v)| v.is_some())
-                    .fold(0, |bits, (i, _)| bits | 1 << i),
+                shadowed: bits(&|i| views[i].is_some()),
+                // Soft shadows where the map can take them: directional (linear depth).
+                soft: bits(&|i| {
+                    views[i].is_some()
+                        && lights[i].angular_radius > 0.0
+                        && matches!(lights[i].source, LightSource::Directional(_))
+                }),
             },
             env: upload_env(ctx, &scene.env)?,
             env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {

@@ -97,6 +97,10 @@ pub struct Light {
     pub irradiance: Vec3,
     /// Whether it casts shadows (a shadow map, light::shadow).
     pub shadow: bool,
+    /// Angular radius of the source seen from the scene, radians (0: a point or
+    /// a perfectly parallel beam). Directional lights only: it sets the penumbra
+    /// and widens the specular lobe.
+    pub angular_radius: f32,
 }
 
 /// The distance at which a point light's `intensity` is its irradiance (scene-format.md).
@@ -219,6 +223,7 @@ impl Scene {
                 },
                 irradiance: Vec3::from(l.color) * l.intensity,
                 shadow: l.shadow,
+                angular_radius: 0.0,
             })
             .collect();
         Ok(Scene {

@@ -55,6 +55,7 @@ impl IrradiancePass {
             .bind(pass, inputs)
             .sample(shadows, &s.shadow)
             .texture(&tables.hemispherical, &tables.sampler)
+            .sample(shadows, &s.nearest)
             .color(&mut out, LoadOp::Clear([0.0; 4]))
             .constants(&mix);
         inputs.mesh.draw(pass);

@@ -104,7 +104,8 @@ impl ShadePass {
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
-        // specular environment, six blur levels, the specular bindings.
+        // specular environment, six blur levels, the specular bindings, the atlas
+        // again as plain depth (soft shadows).
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -118,6 +119,7 @@ impl ShadePass {
         }
         let pass = tables
             .bind(pass, inputs)
+            .sample(images.shadows, &s.nearest)
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {
