@@ -339,6 +339,101 @@ fn shadow_maps_match_analytic_shadows_in_screen_space() {
     );
 }
 
+/// Fraction of a source of angular radius `alpha` around `l` that `p` sees
+/// past `occluder`: the source's cap sampled at `n` points (a Fibonacci
+/// spiral, uniform in solid angle), a ray to each.
+fn source_visible(p: Vec3, l: Vec3, alpha: f32, (c, r): (Vec3, f32), n: usize) -> f32 {
+    let (t, b) = l.any_orthonormal_pair();
+    let visible = (0..n)
+        .filter(|&k| {
+            let cos = 1.0 - (1.0 - alpha.cos()) * (k as f32 + 0.5) / n as f32;
+            let sin = (1.0 - cos * cos).max(0.0).sqrt();
+            let phi = k as f32 * 2.399_963;
+            let d = cos * l + sin * (phi.cos() * t + phi.sin() * b);
+            let tc = (c - p).dot(d);
+            tc <= 0.0 || (c - p - tc * d).length() > r
+        })
+        .count();
+    visible as f32 / n as f32
+}
+
+#[test]
+fn soft_shadows_follow_the_source_size() {
+    // A 4°-radius source (a softbox) over the big sphere, the small one between:
+    // a penumbra a few mm wide. Reference: the source's visible fraction by ray
+    // casting (1024 directions) × N·L at its centre. The soft shadows turn their
+    // taps per pixel, which is noise, so both images are compared after a 5 × 5
+    // box filter: the penumbra's place, width and profile, not its grain.
+    let alpha = 4f32.to_radians();
+    let s = ShadowScene::new();
+    let mut scene = s.scene;
+    let dir = (s.small.0 - s.big.0)
+        .normalize()
+        .lerp(Vec3::Y, 0.15)
+        .normalize();
+    scene.lights = vec![Light {
+        source: LightSource::Directional(dir),
+        irradiance: Vec3::splat(3.0),
+        shadow: true,
+        angular_radius: alpha,
+    }];
+    let img = render(&scene, View::Direct);
+    let hits = pixel_hits(&scene.camera, &[s.big, s.small]);
+    let peak = ALBEDO / std::f32::consts::PI * 3.0;
+    // Per compared pixel: (GPU, ray-cast reference, a hard shadow), / peak.
+    let values: Vec<Option<[f32; 3]>> = hits
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            let (k, p) = (*h)?;
+            let n = p.normalize();
+            let n_dot_l = n.dot(dir);
+            if k != 0 || n.dot((scene.camera.position - p).normalize()) < 0.3 || n_dot_l < 0.15 {
+                return None;
+            }
+            let v = source_visible(p, dir, alpha, s.small, 1024);
+            let hard = source_visible(p, dir, 0.0, s.small, 1);
+            Some([img[i * 4] / peak, n_dot_l * v, n_dot_l * hard])
+        })
+        .collect();
+    let size = SIZE as usize;
+    let (mut count, mut soft_err, mut hard_err) = (0usize, 0.0f32, 0.0f32);
+    for y in 2..size - 2 {
+        for x in 2..size - 2 {
+            let window: Option<Vec<[f32; 3]>> = (0..25)
+                .map(|k| values[(y + k / 5 - 2) * size + x + k % 5 - 2])
+                .collect();
+            let Some(window) = window else { continue };
+            let mean = |c: usize| window.iter().map(|w| w[c]).sum::<f32>() / 25.0;
+            let (gpu, reference, hard) = (mean(0), mean(1), mean(2));
+            // The penumbra: the source partly visible at this pixel.
+            let p = hits[y * size + x].unwrap().1;
+            let v = source_visible(p, dir, alpha, s.small, 1024);
+            if v > 0.02 && v < 0.98 {
+                count += 1;
+                soft_err += (gpu - reference).abs();
+                hard_err += (hard - reference).abs();
+            }
+        }
+    }
+    let (soft_err, hard_err) = (
+        soft_err / count.max(1) as f32,
+        hard_err / count.max(1) as f32,
+    );
+    println!(
+        "soft shadow, 4° source: {count} penumbra pixels, mean |GPU − ray cast| {:.2} % of the \
+         peak after a 5×5 box filter (a hard shadow: {:.2} %)",
+        100.0 * soft_err,
+        100.0 * hard_err
+    );
+    assert!(count > 300, "{count} penumbra pixels");
+    assert!(soft_err < 0.03, "mean penumbra error {soft_err}");
+    assert!(
+        hard_err > 2.0 * soft_err,
+        "a hard shadow would pass: {hard_err}"
+    );
+}
+
 #[test]
 fn shadow_maps_shadow_the_texture_space_irradiance() {
     let s = ShadowScene::new();

@@ -32,10 +32,30 @@ vec2 vogel_tap(int k, int n, float phi) {
     return sqrt((float(k) + 0.5) / float(n)) * vec2(cos(a), sin(a));
 }
 
+// Receiver-plane depth slope (Isidoro 2006): d depth / d(atlas u, v) on the plane
+// through the shaded point with normal ng, seen by light i's (orthographic) map,
+// so that wide kernels compare each tap with the surface under it rather than
+// with the point's own depth. Clamped where the plane is seen nearly edge-on.
+vec2 receiver_slope(int i, vec3 ng, vec2 step) {
+    vec3 t1 = normalize(cross(ng, abs(ng.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
+    vec3 t2 = cross(ng, t1);
+    vec3 a = (frame.light_shadow[i] * vec4(t1, 0.0)).xyz;
+    vec3 b = (frame.light_shadow[i] * vec4(t2, 0.0)).xyz;
+    mat2 j = mat2(a.xy, b.xy);
+    if (abs(determinant(j)) < 1e-12) return vec2(0.0);
+    vec2 slope = vec2(a.z, b.z) * inverse(j);
+    // At most an 80° tilt: tan 80° = 5.7 mm of depth per mm, one texel (texel mm
+    // across, `step` in uv) per depth range (mm).
+    float limit = 5.7 * frame.light_color[i].w / frame.light_params[i].y / max(step.x, step.y);
+    float len = length(slope);
+    return len > limit ? slope * (limit / len) : slope;
+}
+
 // Fraction of a source of angular radius atan(tan_r) that reaches the atlas
-// point s (u, v, depth): blockers found within the reach of the source's cone
-// give the penumbra's radius (receiver − blocker distance)·tan r.
-float soft_visibility(int i, vec3 s, vec2 step) {
+// point s (u, v, depth) on a surface of normal ng: blockers found within the
+// reach of the source's cone give the penumbra's radius, (receiver − blocker
+// distance)·tan r, averaged over the blockers (Fernando 2005).
+float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
     float tan_r = frame.light_params[i].x;
     float range = frame.light_params[i].y;
     float texel = frame.light_color[i].w;
@@ -43,23 +63,27 @@ float soft_visibility(int i, vec3 s, vec2 step) {
     vec2 tiles = frame.params.zw;
     vec2 lo = floor(s.xy * tiles) / tiles + 0.5 * step;
     vec2 hi = lo + 1.0 / tiles - step;
+    vec2 slope = receiver_slope(i, ng, step);
+    float eps = texel / range;   // one texel of depth
     float phi = soft_shadow_angle();
     float search = clamp(s.z * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
-    float blockers = 0.0, count = 0.0;
+    float distance = 0.0, count = 0.0;
     for (int k = 0; k < BLOCKER_TAPS; ++k) {
-        vec2 p = clamp(s.xy + vogel_tap(k, BLOCKER_TAPS, phi) * search * step, lo, hi);
+        vec2 d = vogel_tap(k, BLOCKER_TAPS, phi) * search * step;
+        vec2 p = clamp(s.xy + d, lo, hi);
+        float receiver = s.z + dot(slope, p - s.xy);
         float z = textureLod(shadow_depth, p, 0.0).r;
-        if (z < s.z) {
-            blockers += z;
+        if (z < receiver - eps) {
+            distance += receiver - z;
             count += 1.0;
         }
     }
     if (count == 0.0) return 1.0;
-    float radius = clamp((s.z - blockers / count) * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
+    float radius = clamp(distance / count * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float lit = 0.0;
     for (int k = 0; k < PCF_TAPS; ++k) {
         vec2 p = clamp(s.xy + vogel_tap(k, PCF_TAPS, phi + 1.0) * radius * step, lo, hi);
-        lit += texture(shadow_atlas, vec3(p, s.z));
+        lit += texture(shadow_atlas, vec3(p, s.z + dot(slope, p - s.xy)));
     }
     return lit / float(PCF_TAPS);
 }
@@ -73,7 +97,7 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     s.xyz /= s.w;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
     vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
-    if ((SOFT_LIGHTS & (1 << i)) != 0) return soft_visibility(i, s.xyz, step);
+    if ((SOFT_LIGHTS & (1 << i)) != 0) return soft_visibility(i, s.xyz, ng, step);
     float lit = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
