@@ -1,7 +1,8 @@
 //! The error of an image against a reference over the face: RMSE and maximum of
 //! the absolute difference relative to the reference's mean, its 99th percentile,
 //! and PSNR against the reference's peak, over the RGB channels of the pixels a
-//! mask keeps (the mesh's coverage: alpha > 0.5 with `render.skybox = false`).
+//! mask keeps (the mesh's coverage: alpha > 0.5 with `render.skybox = false`);
+//! and per-pixel relative errors of luminance (mean, median, 90th percentile).
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -63,6 +64,67 @@ pub fn compare(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<ImageE
     })
 }
 
+/// Per-pixel relative error of an image's luminance against a reference's, over
+/// a mask: |a − r| / max(r, floor), floor = [`RELATIVE_FLOOR`] × the mean
+/// reference luminance, so deep shadows (r → 0) do not divide by nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RelativeError {
+    pub mean: f64,
+    pub median: f64,
+    pub p90: f64,
+    /// Share of pixels within 5 %.
+    pub within_5_percent: f64,
+    pub pixels: usize,
+}
+
+/// The floor of [`RelativeError`]'s denominator, as a share of the mean.
+pub const RELATIVE_FLOOR: f64 = 0.02;
+
+/// Rec. 709 luminance of an RGBA pixel.
+fn luminance(p: &[f32]) -> f64 {
+    0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+}
+
+/// [`RelativeError`] of `image` against `reference` (RGBA f32, same size) over `mask`.
+pub fn relative(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<RelativeError> {
+    if reference.len() != image.len() || reference.len() != 4 * mask.len() {
+        return Err(Error::Input(format!(
+            "relative error: sizes differ ({} and {} values, mask of {} pixels)",
+            reference.len(),
+            image.len(),
+            mask.len()
+        )));
+    }
+    let pairs: Vec<(f64, f64)> = reference
+        .chunks_exact(4)
+        .zip(image.chunks_exact(4))
+        .zip(mask)
+        .filter(|(_, &m)| m)
+        .map(|((r, a), _)| (luminance(r), luminance(a)))
+        .collect();
+    let mean = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.len().max(1) as f64;
+    if pairs.is_empty() || mean <= 0.0 || !mean.is_finite() {
+        return Err(Error::Input(format!(
+            "relative error: no covered pixels with a positive mean ({} pixels, mean {mean})",
+            pairs.len()
+        )));
+    }
+    let floor = RELATIVE_FLOOR * mean;
+    let mut rel: Vec<f64> = pairs
+        .iter()
+        .map(|(r, a)| (a - r).abs() / r.max(floor))
+        .collect();
+    rel.sort_by(f64::total_cmp);
+    let at = |q: f64| rel[((rel.len() - 1) as f64 * q).round() as usize];
+    Ok(RelativeError {
+        mean: rel.iter().sum::<f64>() / rel.len() as f64,
+        median: at(0.5),
+        p90: at(0.9),
+        within_5_percent: rel.iter().filter(|&&e| e <= 0.05).count() as f64 / rel.len() as f64,
+        pixels: rel.len(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,10 +166,36 @@ mod tests {
     }
 
     #[test]
+    fn relative_errors_of_known_images() {
+        // Reference 1, 2, 4, 8 (mean 3.75); the image 10 % high on the first
+        // three, 30 % low on the last: mean (0.1·3 + 0.3)/4, median and p90 by rank.
+        let r = image(4, |x| (1 << x) as f32, |_| 1.0);
+        let a = image(
+            4,
+            |x| (1 << x) as f32 * if x < 3 { 1.1 } else { 0.7 },
+            |_| 1.0,
+        );
+        let e = relative(&r, &a, &coverage_mask(&r)).unwrap();
+        assert!((e.mean - 0.15).abs() < 1e-6, "{e:?}");
+        assert!(
+            (e.median - 0.1).abs() < 1e-6 && (e.p90 - 0.3).abs() < 1e-6,
+            "{e:?}"
+        );
+        assert_eq!((e.within_5_percent, e.pixels), (0.0, 4));
+        // A pixel black in the reference divides by the floor, 2 % of the mean.
+        let r = image(2, |x| [0.0, 2.0][x], |_| 1.0);
+        let a = image(2, |x| [0.01, 2.0][x], |_| 1.0);
+        let e = relative(&r, &a, &coverage_mask(&r)).unwrap();
+        assert!((e.mean - 0.5 * 0.01 / (0.02 * 1.0)).abs() < 1e-6, "{e:?}");
+    }
+
+    #[test]
     fn an_empty_mask_or_mismatched_sizes_are_errors() {
         let r = image(4, |_| 1.0, |_| 0.0);
         assert!(compare(&r, &r, &coverage_mask(&r)).is_err());
         let s = image(3, |_| 1.0, |_| 1.0);
         assert!(compare(&r, &s, &coverage_mask(&r)).is_err());
+        assert!(relative(&r, &r, &coverage_mask(&r)).is_err());
+        assert!(relative(&r, &s, &coverage_mask(&r)).is_err());
     }
 }
