@@ -3,7 +3,9 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{default_scene_path, scene_by_name, Chain, Kernel, Occlusion, UvOrigin};
+use dermis::scene::file::{
+    default_scene_path, scene_by_name, Chain, Kernel, LightsMode, Occlusion, UvOrigin,
+};
 use dermis::scene::Overrides;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -156,6 +158,11 @@ enum Command {
         /// Environment rotation about +Y, degrees.
         #[arg(long, allow_hyphen_values = true)]
         env_rotate: Option<f32>,
+        /// Bright sources taken out of the environment as shadowed directional
+        /// lights, replacing the scene's `environment.lights`: `auto` (compact
+        /// sources holding ≥ 5 % of the energy) or a count 0..=8 (0: none).
+        #[arg(long, value_name = "auto|N", allow_hyphen_values = true)]
+        env_lights: Option<LightsMode>,
         /// Exposure in EV stops.
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f32>,
@@ -425,6 +432,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             mm_per_unit,
             env,
             env_rotate,
+            env_lights,
             exposure,
             irradiance_res,
             occlusion,
@@ -448,6 +456,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 mm_per_unit,
                 env,
                 env_rotate_deg: env_rotate,
+                env_lights,
                 exposure,
                 irradiance_resolution: irradiance_res,
                 occlusion,
