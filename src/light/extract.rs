@@ -66,6 +66,8 @@ pub const MAX_SOLID_ANGLE_SR: f32 = 0.1;
 const HALO_FALLOFF_PER_DEG: f64 = 1.31;
 /// The halo reaches at most this far beyond the core, degrees.
 const MAX_HALO_DEG: f64 = 5.0;
+/// Upper bound on the fill's relaxation sweeps (the CC0 maps need 48–282).
+const MAX_FILL_SWEEPS: usize = 20_000;
 
 /// Rec. 709 / sRGB luminance weights.
 const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
@@ -455,9 +457,6 @@ fn harmonic_fill(grid: &Grid, map: &EnvMap, region: &[usize]) -> Option<Vec<Vec3
     }
     Some(f)
 }
-
-/// Upper bound on the fill's relaxation sweeps (it converges in far fewer).
-const MAX_FILL_SWEEPS: usize = 20_000;
 
 /// The light of `region` once its texels become `filled`.
 fn measure(
