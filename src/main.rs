@@ -2,8 +2,11 @@
 
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
+use dermis::light::extract;
 use dermis::render::{render, RenderOptions, View};
-use dermis::scene::file::{default_scene_path, scene_by_name, Chain, Kernel, Occlusion, UvOrigin};
+use dermis::scene::file::{
+    default_scene_path, scene_by_name, Chain, Kernel, LightsMode, Occlusion, UvOrigin,
+};
 use dermis::scene::Overrides;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -66,6 +69,31 @@ enum Command {
         /// Also print the GPU passes' timings.
         #[arg(long)]
         timings: bool,
+    },
+    /// List the bright sources (suns, softboxes) taken out of an environment as lights.
+    ///
+    /// Per light: its direction (world, after --rotate), elevation and azimuth,
+    /// solid angle, angular radius, power (RGB irradiance at normal incidence) and
+    /// share of the map's energy; then the residual's share (docs/lighting.md).
+    /// Shares are fractions in --json. Runs on the CPU.
+    #[command(after_help = AFTER_HELP)]
+    Lights {
+        /// A .hdr/.exr file, a cross, `cube:...`, `uniform:R,G,B` or `sky[:...]`.
+        env: String,
+        /// Rotation of the environment about +Y, degrees (as `environment.rotation_deg`).
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        rotate: f32,
+        /// `auto` (compact sources holding ≥ 5 % of the energy) or the N strongest (0..=8).
+        #[arg(
+            long,
+            default_value = "auto",
+            value_name = "auto|N",
+            allow_hyphen_values = true
+        )]
+        lights: LightsMode,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
     },
     /// Compute (and cache) the per-vertex occlusion transfer ahead of rendering.
     #[command(after_help = AFTER_HELP)]
@@ -156,6 +184,11 @@ enum Command {
         /// Environment rotation about +Y, degrees.
         #[arg(long, allow_hyphen_values = true)]
         env_rotate: Option<f32>,
+        /// Bright sources taken out of the environment as shadowed directional
+        /// lights, replacing the scene's `environment.lights`: `auto` (compact
+        /// sources holding ≥ 5 % of the energy) or a count 0..=8 (0: none).
+        #[arg(long, value_name = "auto|N", allow_hyphen_values = true)]
+        env_lights: Option<LightsMode>,
         /// Exposure in EV stops.
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f32>,
@@ -341,6 +374,89 @@ fn run(cli: Cli) -> dermis::Result<()> {
             }
             Ok(())
         }
+        Command::Lights {
+            env,
+            rotate,
+            lights,
+            json,
+        } => {
+            let (w, h) = dermis::scene::PROCEDURAL_ENV_SIZE;
+            let source: dermis::scene::env::EnvSource = env.parse()?;
+            let (map, _) = dermis::scene::env::resolve(&source, w, h)?;
+            let found = extract::extract(&map, lights).lights;
+            let residual = 1.0 - found.iter().map(|l| l.share).sum::<f32>();
+            let rows: Vec<_> = found
+                .iter()
+                .map(|l| {
+                    let d = l.world_direction(rotate);
+                    let (elevation, azimuth) = extract::elevation_azimuth_deg(d);
+                    (l, d, elevation, azimuth)
+                })
+                .collect();
+            if json {
+                let lights_json: Vec<_> = rows
+                    .iter()
+                    .map(|(l, d, elevation, azimuth)| {
+                        serde_json::json!({
+                            "direction": [d.x, d.y, d.z],
+                            "elevation_deg": elevation,
+                            "azimuth_deg": azimuth,
+                            "solid_angle_sr": l.solid_angle_sr,
+                            "angular_radius_deg": l.angular_radius_rad.to_degrees(),
+                            "power": [l.power.x, l.power.y, l.power.z],
+                            "share": l.share,
+                            "texels": l.texels,
+                        })
+                    })
+                    .collect();
+                let out = serde_json::json!({
+                    "environment": env,
+                    "rotation_deg": rotate,
+                    "mode": lights,
+                    "lights": lights_json,
+                    "residual_share": residual,
+                });
+                println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+            } else {
+                println!(
+                    "{env}, rotated {rotate}°, lights {lights}: {} found",
+                    rows.len()
+                );
+                if !rows.is_empty() {
+                    println!(
+                        "{:>2} {:>9} {:>8}  {:<24}  {:>11} {:>7}  {:<30}  {:>7}",
+                        "#",
+                        "elevation",
+                        "azimuth",
+                        "direction (world)",
+                        "solid angle",
+                        "radius",
+                        "power (R, G, B)",
+                        "share"
+                    );
+                }
+                for (i, (l, d, elevation, azimuth)) in rows.iter().enumerate() {
+                    println!(
+                        "{:>2} {:>8.2}° {:>7.2}°  ({:>6.3}, {:>6.3}, {:>6.3})  {:>8.5} sr {:>6.2}°  \
+                         ({:>8.4}, {:>8.4}, {:>8.4})  {:>5.1} %",
+                        i + 1,
+                        elevation,
+                        azimuth,
+                        d.x,
+                        d.y,
+                        d.z,
+                        l.solid_angle_sr,
+                        l.angular_radius_rad.to_degrees(),
+                        l.power.x,
+                        l.power.y,
+                        l.power.z,
+                        100.0 * l.share
+                    );
+                }
+                println!("residual: {:.1} % of the energy", 100.0 * residual);
+            }
+            Ok(())
+        }
         Command::Sweep {
             scene,
             resolutions,
@@ -425,6 +541,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             mm_per_unit,
             env,
             env_rotate,
+            env_lights,
             exposure,
             irradiance_res,
             occlusion,
@@ -448,6 +565,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 mm_per_unit,
                 env,
                 env_rotate_deg: env_rotate,
+                env_lights,
                 exposure,
                 irradiance_resolution: irradiance_res,
                 occlusion,

@@ -365,6 +365,10 @@ fn bad_scene_input_is_a_clean_error() {
     assert_bad_input(&["--env", "uniform:1,nan,1"], "uniform");
     assert_bad_input(&["--irradiance-res", "3000"], "irradiance_resolution");
     assert_bad_input(
+        &["--env-lights", "many"],
+        "invalid value 'many' for '--env-lights",
+    );
+    assert_bad_input(
         &["--uv-origin", "upper-left"],
         "invalid value 'upper-left' for '--uv-origin",
     );
@@ -487,6 +491,41 @@ fn sh_prints_the_projection_of_a_constant_sky() {
 }
 
 #[test]
+fn lights_prints_the_sun_of_the_sky() {
+    // The built-in sky's sun: elevation 30°, azimuth 295°; --rotate 90 adds 90° of azimuth.
+    let out = dermis(&["lights", "sky", "--rotate", "90", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["mode"], "auto");
+    let lights = v["lights"].as_array().unwrap();
+    assert_eq!(lights.len(), 1, "{v}");
+    let sun = &lights[0];
+    let number = |key: &str| sun[key].as_f64().unwrap_or_else(|| panic!("{key}: {sun}"));
+    assert!((number("elevation_deg") - 30.0).abs() < 0.5, "{sun}");
+    assert!((number("azimuth_deg") - 25.0).abs() < 0.5, "{sun}");
+    assert!(number("solid_angle_sr") > 0.0 && number("angular_radius_deg") > 0.0);
+    assert!(number("texels") >= 1.0);
+    assert_eq!(sun["direction"].as_array().unwrap().len(), 3);
+    assert_eq!(sun["power"].as_array().unwrap().len(), 3);
+    let (share, residual) = (number("share"), v["residual_share"].as_f64().unwrap());
+    assert!((share + residual - 1.0).abs() < 1e-5, "{v}");
+
+    let out = dermis(&["lights", "uniform:1", "--lights", "0"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("residual: 100.0 %"));
+    let out = dermis(&["lights", "/no/such/dir/none.hdr"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("none.hdr"));
+    let out = dermis(&["lights", "sky", "--lights", "-1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("got '-1'"));
+}
+
+#[test]
 fn precompute_fills_the_cache_and_reports_time() {
     let cache = tmp("cache");
     let run = || {
@@ -521,7 +560,7 @@ fn zero_frames_is_a_clean_input_error() {
 
 #[test]
 fn help_documents_every_flag_the_environment_and_exit_codes() {
-    for command in ["info", "sh", "precompute", "render"] {
+    for command in ["info", "sh", "lights", "precompute", "render"] {
         let out = dermis(&[command, "--help"]);
         assert!(out.status.success(), "{command} --help");
         let help = String::from_utf8_lossy(&out.stdout).to_string();
@@ -557,7 +596,13 @@ fn help_documents_every_flag_the_environment_and_exit_codes() {
     }
     // Value lists come from the enums.
     let help = String::from_utf8_lossy(&dermis(&["render", "--help"]).stdout).to_string();
-    for value in ["blur6", "prefiltered", "raytrace", "bottom-left"] {
+    for value in [
+        "blur6",
+        "prefiltered",
+        "raytrace",
+        "bottom-left",
+        "--env-lights",
+    ] {
         assert!(help.contains(value), "render --help lacks {value}");
     }
 }

@@ -1,7 +1,9 @@
 //! Environment lighting: spherical harmonics (Ramamoorthi & Hanrahan 2001; the
-//! paper's section III). Environment maps and the sky are in `scene::env`.
+//! paper's section III), and the bright sources taken out of the map as lights
+//! (`extract`). Environment maps and the sky are in `scene::env`.
 
 pub mod direct;
+pub mod extract;
 pub mod occlusion;
 pub mod prefilter;
 pub mod sh;

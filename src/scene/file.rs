@@ -153,6 +153,10 @@ pub struct Environment {
     pub rotation_deg: f32,
     /// Radiance multiplier.
     pub intensity: f32,
+    /// Which bright sources are taken out of the map as directional lights
+    /// (`light::extract`).
+    #[serde(deserialize_with = "env_lights")]
+    pub lights: LightsMode,
 }
 
 impl Default for Environment {
@@ -161,8 +165,103 @@ impl Default for Environment {
             source: EnvSource::Sky(SkyParams::default()),
             rotation_deg: 0.0,
             intensity: 1.0,
+            lights: LightsMode::Auto,
         }
     }
+}
+
+/// Most lights `light::extract` takes out of one environment map: each costs a
+/// shadow map per frame, and the CC0 maps need at most 4 (docs/lighting.md).
+pub const MAX_EXTRACTED_LIGHTS: usize = 8;
+
+/// How many bright sources are extracted from the environment map as lights:
+/// `"auto"` or a count `0..=`[`MAX_EXTRACTED_LIGHTS`] (0: none, the map is used
+/// whole). Written `auto` or `N` (scene file: the string `"auto"` or an integer).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightsMode {
+    /// Every compact source holding a large share of the map's energy (the rule
+    /// in `light::extract`).
+    #[default]
+    Auto,
+    /// The `n` strongest candidates, whatever their share or size.
+    Count(usize),
+}
+
+impl LightsMode {
+    fn bad(value: impl fmt::Display) -> String {
+        format!(
+            "expected \"auto\" or a number of lights in 0..={MAX_EXTRACTED_LIGHTS}, got '{value}'"
+        )
+    }
+
+    fn count(n: i128) -> Result<LightsMode, String> {
+        match usize::try_from(n) {
+            Ok(n) if n <= MAX_EXTRACTED_LIGHTS => Ok(LightsMode::Count(n)),
+            _ => Err(LightsMode::bad(n)),
+        }
+    }
+}
+
+impl std::str::FromStr for LightsMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<LightsMode, String> {
+        match s.trim() {
+            "auto" => Ok(LightsMode::Auto),
+            t => match t.parse::<i128>() {
+                Ok(n) => LightsMode::count(n),
+                Err(_) => Err(LightsMode::bad(s)),
+            },
+        }
+    }
+}
+
+impl fmt::Display for LightsMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LightsMode::Auto => f.write_str("auto"),
+            LightsMode::Count(n) => write!(f, "{n}"),
+        }
+    }
+}
+
+impl Serialize for LightsMode {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            LightsMode::Auto => s.serialize_str("auto"),
+            LightsMode::Count(n) => s.serialize_u64(*n as u64),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for LightsMode {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<LightsMode, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = LightsMode;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                write!(
+                    f,
+                    "\"auto\" or a number of lights in 0..={MAX_EXTRACTED_LIGHTS}"
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<LightsMode, E> {
+                s.parse().map_err(E::custom)
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<LightsMode, E> {
+                LightsMode::count(v.into()).map_err(E::custom)
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<LightsMode, E> {
+                LightsMode::count(v.into()).map_err(E::custom)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `environment.lights`: [`LightsMode`]'s message, prefixed with the key.
+fn env_lights<'de, D: Deserializer<'de>>(d: D) -> Result<LightsMode, D::Error> {
+    LightsMode::deserialize(d)
+        .map_err(|e| serde::de::Error::custom(format!("environment.lights: {e}")))
 }
 
 /// The message for an empty `environment.source` (scene file or `--env`).
@@ -1022,6 +1121,54 @@ gamma = 2.2
                 "{src}: {msg}"
             );
         }
+    }
+
+    #[test]
+    fn environment_lights_auto_or_a_count() {
+        assert_eq!(parse("").unwrap().environment.lights, LightsMode::Auto);
+        for (text, mode) in [
+            ("\"auto\"", LightsMode::Auto),
+            ("0", LightsMode::Count(0)),
+            ("3", LightsMode::Count(3)),
+            ("8", LightsMode::Count(8)),
+            ("\"2\"", LightsMode::Count(2)),
+        ] {
+            let s = parse(&format!("[environment]\nlights = {text}")).unwrap();
+            assert_eq!(s.environment.lights, mode, "{text}");
+        }
+        for (text, needle) in [
+            ("-1", "got '-1'"),
+            ("9", "got '9'"),
+            ("\"sometimes\"", "got 'sometimes'"),
+            ("\"-2\"", "got '-2'"),
+            ("1.5", "floating point `1.5`"),
+            ("true", "boolean `true`"),
+        ] {
+            let msg = err(&format!("[environment]\nlights = {text}"));
+            assert!(
+                msg.contains("line 2,")
+                    && msg.contains("environment.lights")
+                    && msg.contains(needle),
+                "{text}: {msg}"
+            );
+        }
+        // The same grammar on the command line and in JSON.
+        for mode in [LightsMode::Auto, LightsMode::Count(0), LightsMode::Count(5)] {
+            assert_eq!(mode.to_string().parse::<LightsMode>(), Ok(mode));
+            let json = serde_json::to_string(&mode).unwrap();
+            assert_eq!(serde_json::from_str::<LightsMode>(&json).unwrap(), mode);
+        }
+        assert_eq!(
+            serde_json::to_string(&LightsMode::Auto).unwrap(),
+            "\"auto\""
+        );
+        assert_eq!(serde_json::to_string(&LightsMode::Count(3)).unwrap(), "3");
+        let e = "-3".parse::<LightsMode>().unwrap_err();
+        assert_eq!(
+            e,
+            "expected \"auto\" or a number of lights in 0..=8, got '-3'"
+        );
+        assert!("".parse::<LightsMode>().unwrap_err().contains("got ''"));
     }
 
     #[test]

@@ -33,6 +33,8 @@ pub struct Overrides {
     /// `--env`: a source string, parsed by [`Overrides::apply`].
     pub env: Option<String>,
     pub env_rotate_deg: Option<f32>,
+    /// `--env-lights`: replaces `environment.lights`.
+    pub env_lights: Option<file::LightsMode>,
     pub exposure: Option<f32>,
     pub irradiance_resolution: Option<u32>,
     pub occlusion: Option<Occlusion>,
@@ -63,6 +65,7 @@ impl Overrides {
         }
         file.environment.rotation_deg =
             self.env_rotate_deg.unwrap_or(file.environment.rotation_deg);
+        file.environment.lights = self.env_lights.unwrap_or(file.environment.lights);
         file.render.exposure = self.exposure.or(file.render.exposure);
         file.render.irradiance_resolution = self
             .irradiance_resolution

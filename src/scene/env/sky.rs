@@ -289,7 +289,9 @@ pub fn render_sky(p: &SkyParams, width: u32, height: u32) -> EnvMap {
     render_sky_impl(p, width, height, true)
 }
 
-fn render_sky_impl(p: &SkyParams, width: u32, height: u32, with_sun: bool) -> EnvMap {
+/// [`render_sky`], with or without the sun disk (the sky alone is what tests
+/// of the disk and of `light::extract` compare with).
+pub(crate) fn render_sky_impl(p: &SkyParams, width: u32, height: u32, with_sun: bool) -> EnvMap {
     let p = p.clamped();
     let model = Preetham::new(&p);
     let mut env = EnvMap::from_fn(width, height, |d| {
