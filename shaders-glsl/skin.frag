@@ -62,7 +62,7 @@ void main() {
     vec3 spec = vec3(0.0);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
-        vec3 e = light_irradiance(i, v_position, v_normal, l);
+        vec3 e = light_irradiance(i, v_position, v_normal, n, l);
         spec += e * ks_specular(n, l, v, light_lobe(i, params));
     }
     // The environment's share, occluded like the diffuse by the vertex's

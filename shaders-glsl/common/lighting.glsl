@@ -23,7 +23,7 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
 #endif
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
-        vec3 e_light = light_irradiance(i, x, ng, l);
+        vec3 e_light = light_irradiance(i, x, ng, n, l);
         float n_dot_l = max(dot(n, l), 0.0);
 #ifdef ENERGY_CONSERVING
         n_dot_l *= diffuse_transmission(n_dot_l, light_lobe(i, spec_params));

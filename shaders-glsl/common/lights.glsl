@@ -21,14 +21,17 @@ const int BLOCKER_TAPS = 12;
 const int PCF_TAPS = 16;
 const float MAX_SOFT_TEXELS = 48.0;
 
-// Interleaved gradient noise (Jimenez 2014): a per-pixel angle in [0, 2π).
-float soft_shadow_angle() {
-    return 6.2831853 * fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+// A per-pixel rotation by interleaved gradient noise (Jimenez 2014).
+mat2 soft_shadow_turn() {
+    float a = 6.2831853 * fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+    float c = cos(a), s = sin(a);
+    return mat2(c, s, -s, c);
 }
 
-// Tap k of n on a unit Vogel disk turned by phi (radius √((k + ½)/n)).
-vec2 vogel_tap(int k, int n, float phi) {
-    float a = float(k) * 2.39996323 + phi;
+// Tap k of n on a unit Vogel disk (radius √((k + ½)/n), golden angle): constant
+// once the loops are unrolled, so a tap costs one rotation.
+vec2 vogel_tap(int k, int n) {
+    float a = float(k) * 2.39996323;
     return sqrt((float(k) + 0.5) / float(n)) * vec2(cos(a), sin(a));
 }
 
@@ -65,11 +68,11 @@ float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
     vec2 hi = lo + 1.0 / tiles - step;
     vec2 slope = receiver_slope(i, ng, step);
     float eps = texel / range;   // one texel of depth
-    float phi = soft_shadow_angle();
+    mat2 turn = soft_shadow_turn();
     float search = clamp(s.z * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float distance = 0.0, count = 0.0;
     for (int k = 0; k < BLOCKER_TAPS; ++k) {
-        vec2 d = vogel_tap(k, BLOCKER_TAPS, phi) * search * step;
+        vec2 d = turn * vogel_tap(k, BLOCKER_TAPS) * search * step;
         vec2 p = clamp(s.xy + d, lo, hi);
         float receiver = s.z + dot(slope, p - s.xy);
         float z = textureLod(shadow_depth, p, 0.0).r;
@@ -82,7 +85,7 @@ float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
     float radius = clamp(distance / count * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float lit = 0.0;
     for (int k = 0; k < PCF_TAPS; ++k) {
-        vec2 p = clamp(s.xy + vogel_tap(k, PCF_TAPS, phi + 1.0) * radius * step, lo, hi);
+        vec2 p = clamp(s.xy + turn * vogel_tap(k, PCF_TAPS) * radius * step, lo, hi);
         lit += texture(shadow_atlas, vec3(p, s.z + dot(slope, p - s.xy)));
     }
     return lit / float(PCF_TAPS);
@@ -108,8 +111,9 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
 }
 
 // Irradiance light i delivers at x to a surface facing it (shadowed; mirrors
-// scene::Light::at); l: the unit direction towards the light.
-vec3 light_irradiance(int i, vec3 x, vec3 ng, out vec3 l) {
+// scene::Light::at); l: the unit direction towards the light. 0 where the
+// shading normal n faces away from it (its shadow is not looked up there).
+vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, out vec3 l) {
     vec4 lv = frame.light_vec[i];
     vec3 e = frame.light_color[i].rgb;
     float dist = 1.0;
@@ -122,6 +126,7 @@ vec3 light_irradiance(int i, vec3 x, vec3 ng, out vec3 l) {
     } else {
         l = lv.xyz;
     }
+    if (dot(n, l) <= 0.0) return vec3(0.0);
     if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, l, dist);
     return e;
 }

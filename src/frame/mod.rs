@@ -33,7 +33,12 @@ pub struct FrameInputs {
     pub roughness: Arc<Image>,
     /// Lights, shadows, occlusion and maps the shading passes specialise on.
     pub variant: ShaderVariant,
+    /// The environment as given: what the skybox shows.
     pub env: Arc<Image>,
+    /// What lights the skin through SH9 and the specular prefilter: the
+    /// environment less the bright sources taken out as lights (light::extract);
+    /// the same image when none were.
+    pub lighting_env: Arc<Image>,
     /// Linear where the device filters RGBA32F, else nearest.
     pub env_sampler: Arc<Sampler>,
     pub samplers: Arc<Samplers>,

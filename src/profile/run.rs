@@ -34,7 +34,12 @@ pub struct RunSetup {
     /// Occlusion method: `raster`, `raytrace` or `off`.
     pub occlusion: String,
     pub shadow_resolution: u32,
+    /// The scene's explicit lights.
     pub lights: usize,
+    /// `environment.lights`: `auto` or a count.
+    pub environment_lights: String,
+    /// Bright sources taken out of the environment as lights.
+    pub extracted_lights: usize,
 }
 
 /// Device memory at the end of the run.
@@ -194,7 +199,7 @@ impl RunReport {
         format!(
             "{} ({}), API {}, LP_NUM_THREADS={}, dermis {} ({})\n\
              {} {}x{} (render {}x{}), irradiance {}², kernel {}, chain {}, occlusion {}, \
-             mesh {}, env {} @ {}°, {} frame(s), {} warm-up\n",
+             mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} frame(s), {} warm-up\n",
             self.device,
             self.driver.trim(),
             self.api_version,
@@ -213,6 +218,8 @@ impl RunReport {
             s.mesh,
             s.environment,
             s.environment_rotation_deg,
+            s.extracted_lights,
+            s.environment_lights,
             self.frames,
             self.warmup_frames,
         )

@@ -13,6 +13,7 @@ use crate::gpu::{Context, ImageDesc};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, Graph, ImageHandle};
 use crate::light::direct::{DirectPass, DirectView};
+use crate::light::extract::{extract, ExtractedLight};
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
@@ -31,15 +32,32 @@ use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
 use std::sync::Arc;
 
-/// The lights the frame uses: the scene's, at most [`MAX_LIGHTS`].
-fn frame_lights(scene: &Scene) -> Vec<Light> {
-    if scene.lights.len() > MAX_LIGHTS {
+/// The lights the frame uses, at most [`MAX_LIGHTS`]: the scene's, then the
+/// environment's bright sources (`extracted`, in the map's frame) as shadowed
+/// directional lights of their power, turned and scaled like the environment.
+fn frame_lights(scene: &Scene, extracted: &[ExtractedLight]) -> Vec<Light> {
+    let env = &scene.file.environment;
+    let all: Vec<Light> = scene
+        .lights
+        .iter()
+        .copied()
+        .chain(extracted.iter().map(|x| Light {
+            source: LightSource::Directional(x.world_direction(env.rotation_deg)),
+            // A uniform cap of radius α delivers (1 + cos α)/2 of its ∫L dω to a
+            // surface facing it.
+            irradiance: x.power * env.intensity * 0.5 * (1.0 + x.angular_radius_rad.cos()),
+            shadow: true,
+            angular_radius: x.angular_radius_rad,
+        }))
+        .collect();
+    if all.len() > MAX_LIGHTS {
         log::warn!(
-            "only the first {MAX_LIGHTS} of {} lights are used",
-            scene.lights.len()
+            "only the first {MAX_LIGHTS} of {} lights ({} from the environment) are used",
+            all.len(),
+            extracted.len()
         );
     }
-    scene.lights.iter().take(MAX_LIGHTS).copied().collect()
+    all.into_iter().take(MAX_LIGHTS).collect()
 }
 
 /// The shadow projection of each light (`None`: unshadowed).
@@ -159,6 +177,8 @@ pub(super) struct Frame {
     skybox_on: bool,
     exposure: f32,
     gamma: Gamma,
+    /// Bright sources taken out of the environment as lights.
+    pub(super) extracted_lights: usize,
 }
 
 impl Frame {
@@ -170,7 +190,17 @@ impl Frame {
     ) -> Result<Self> {
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let samplers = Arc::new(Samplers::new(ctx)?);
-        let lights = frame_lights(scene);
+        // The environment's bright sources become lights; the rest lights the
+        // skin through SH9 and the prefilter, while the skybox shows it whole.
+        let extraction = extract(&scene.env, scene.file.environment.lights);
+        for (i, l) in extraction.lights.iter().enumerate() {
+            log::info!(
+                "environment light {i}: {:.1}% of the map's energy, {:.2}° across",
+                100.0 * l.share,
+                2.0 * l.angular_radius_rad.to_degrees()
+            );
+        }
+        let lights = frame_lights(scene, &extraction.lights);
         let views = shadow_views(scene, &lights);
         let shadow_res = scene.file.render.shadow_resolution;
         let tiles = views.iter().flatten().count();
@@ -181,6 +211,7 @@ impl Frame {
             ))
         })?;
         let uniforms = frame_uniforms(scene, &lights, w as f32 / h as f32, &views);
+        let env = upload_env(ctx, &scene.env)?;
         // Bit i set where light i has `has`.
         let bits = |has: &dyn Fn(usize) -> bool| {
             (0..lights.len())
@@ -224,7 +255,12 @@ impl Frame {
                         && matches!(lights[i].source, LightSource::Directional(_))
                 }),
             },
-            env: upload_env(ctx, &scene.env)?,
+            lighting_env: if extraction.lights.is_empty() {
+                env.clone()
+            } else {
+                upload_env(ctx, &extraction.residual)?
+            },
+            env,
             env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
                 samplers.linear.clone()
             } else {
@@ -264,7 +300,7 @@ impl Frame {
             sh: ShPasses::new(ctx, samplers.nearest.clone())?,
             sh_buffers: ShBuffers::new(
                 ctx,
-                &inputs.env,
+                &inputs.lighting_env,
                 scene.file.environment.rotation_deg,
                 scene.file.environment.intensity,
             )?,
@@ -279,6 +315,7 @@ impl Frame {
             skybox_on: scene.file.render.skybox,
             exposure: scene.exposure(),
             gamma: scene.file.render.gamma,
+            extracted_lights: extraction.lights.len(),
         })
     }
 
@@ -304,13 +341,16 @@ impl Frame {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let sh = self.sh.passes(
             g,
-            &self.inputs.env,
+            &self.inputs.lighting_env,
             &self.sh_buffers,
             Access::UniformRead,
             first,
         );
         if view == View::Prefiltered {
-            return (self.prefilter.pass(g, &self.inputs.env, first), None);
+            return (
+                self.prefilter.pass(g, &self.inputs.lighting_env, first),
+                None,
+            );
         }
         let shadows = self.shadow.pass(
             g,
@@ -352,7 +392,7 @@ impl Frame {
             if let View::Blur(k) = view {
                 return (levels.swap_remove(k as usize - 1), None);
             }
-            let specular_env = self.prefilter.pass(g, &self.inputs.env, first);
+            let specular_env = self.prefilter.pass(g, &self.inputs.lighting_env, first);
             self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
             let weights: Vec<_> = self
                 .skin

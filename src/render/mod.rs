@@ -59,7 +59,12 @@ impl Default for RenderOptions {
 }
 
 /// What the report says was rendered.
-fn setup(scene: &Scene, opts: &RenderOptions, irradiance_resolution: u32) -> RunSetup {
+fn setup(
+    scene: &Scene,
+    opts: &RenderOptions,
+    irradiance_resolution: u32,
+    extracted_lights: usize,
+) -> RunSetup {
     let f = &scene.file;
     let path = |p: &Option<PathBuf>, none: &str| {
         p.as_ref()
@@ -92,6 +97,8 @@ fn setup(scene: &Scene, opts: &RenderOptions, irradiance_resolution: u32) -> Run
         .into(),
         shadow_resolution: f.render.shadow_resolution,
         lights: f.lights.len(),
+        environment_lights: f.environment.lights.to_string(),
+        extracted_lights,
     }
 }
 
@@ -139,8 +146,9 @@ pub fn render_scene(
     check_target(&ctx.info, screen.0, screen.1)?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
-    let run_setup = setup(scene, opts, skin.resolution);
+    let resolution = skin.resolution;
     let frame = Frame::new(ctx, scene, skin, opts.ruler)?;
+    let run_setup = setup(scene, opts, resolution, frame.extracted_lights);
     // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
     let (w, h) = {
         let (image, _) = frame.graph(&mut Graph::new(), opts.view, screen, true);
