@@ -19,7 +19,7 @@ layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
 #define SHADOW_ATLAS 5
-#define SHADOW_DEPTH 6
+#define SOFT_VISIBILITY 6
 #include "lights.glsl"
 #include "lighting.glsl"
 layout(location = 0) out vec4 color;
@@ -35,7 +35,7 @@ vec3 shading_normal() {
 
 void main() {
     vec3 n = shading_normal();
-    vec3 e = irradiance_at(v_position, v_normal, n, vec2(0.0));
+    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, vec2(0.0));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     color = vec4(albedo / PI_F * e, 1.0);
 }

@@ -28,7 +28,7 @@ layout(location = 6) in vec3 v_t678;
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #define SHADOW_ATLAS 10
-#define SHADOW_DEPTH 12
+#define SOFT_VISIBILITY 12
 #include "lights.glsl"
 #define ENERGY_CONSERVING
 #include "lighting.glsl"
@@ -36,7 +36,7 @@ layout(location = 0) out vec4 irradiance;
 
 void main() {
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-    vec3 e = irradiance_at(v_position, v_normal, n, specular_params(v_uv));
+    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, specular_params(v_uv));
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
 }

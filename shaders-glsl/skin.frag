@@ -10,7 +10,7 @@
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 #define SHADOW_ATLAS 3
-#define SHADOW_DEPTH 17
+#define SOFT_VISIBILITY 17
 #include "lights.glsl"
 // binding 4: the per-vertex transfer, read by mesh_lit.vert.
 #define ENV_SPECULAR 5
@@ -62,7 +62,7 @@ void main() {
     vec3 spec = vec3(0.0);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
-        vec3 e = light_irradiance(i, v_position, v_normal, n, l);
+        vec3 e = light_irradiance(i, v_position, v_normal, n, v_uv, l);
         spec += e * ks_specular(n, l, v, light_lobe(i, params));
     }
     // The environment's share, occluded like the diffuse by the vertex's

@@ -6,7 +6,7 @@
 // With ENERGY_CONSERVING (and ks_specular.glsl with SPEC_HEMISPHERICAL),
 // each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
 // what the specular reflects does not enter the skin.
-vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
+vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {
     vec3 e;
     if (OCCLUSION) {
         e = lighting.sh[0].rgb * v_t012.x + lighting.sh[1].rgb * v_t012.y
@@ -23,7 +23,7 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 spec_params) {
 #endif
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
-        vec3 e_light = light_irradiance(i, x, ng, n, l);
+        vec3 e_light = light_irradiance(i, x, ng, n, uv, l);
         float n_dot_l = max(dot(n, l), 0.0);
 #ifdef ENERGY_CONSERVING
         n_dot_l *= diffuse_transmission(n_dot_l, light_lobe(i, spec_params));

@@ -1,11 +1,14 @@
 // The explicit lights of frame.glsl: directional, or point with 1/d² falloff, each
 // optionally shadowed by its tile of the shadow atlas (light/shadow.rs). Point-like
-// lights are read with 3×3 bilinear PCF; lights with an angular size (the sources
-// extracted from the environment) with percentage-closer soft shadows, so the
-// penumbra follows the source's size. Expects SHADOW_ATLAS and SHADOW_DEPTH: the
-// atlas's bindings, with a depth-comparison and a plain nearest sampler.
+// lights are read with 3×3 bilinear PCF. Lights with an angular size (the sources
+// extracted from the environment) have percentage-closer soft shadows, so the
+// penumbra follows the source's size; they are computed once per frame in texture
+// space by light_visibility.frag (light/visibility.rs), which defines
+// SHADOW_DEPTH (the atlas again, nearest, no comparison), and read back by the
+// shading passes, which define SOFT_VISIBILITY: the first of three bindings of
+// the visibility textures, three lights each, coverage-premultiplied.
+// Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
-layout(binding = SHADOW_DEPTH) uniform sampler2D shadow_depth;
 
 const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 // Acne offsets, in shadow-map texels: along the normal (normal-offset shadows,
@@ -17,8 +20,8 @@ const float LIGHT_OFFSET_TEXELS = 1.0;
 // Soft shadows (Fernando 2005, PCSS): taps of the blocker search and of the
 // filter, on a Vogel (golden-angle) disk turned per pixel; the filter's radius is
 // clamped to what those taps can cover without gaps turning into bands.
-const int BLOCKER_TAPS = 12;
-const int PCF_TAPS = 16;
+const int BLOCKER_TAPS = 8;
+const int PCF_TAPS = 12;
 const float MAX_SOFT_TEXELS = 48.0;
 
 // A per-pixel rotation by interleaved gradient noise (Jimenez 2014).
@@ -34,6 +37,24 @@ vec2 vogel_tap(int k, int n) {
     float a = float(k) * 2.39996323;
     return sqrt((float(k) + 0.5) / float(n)) * vec2(cos(a), sin(a));
 }
+
+// Slot of soft light i among the soft lights (a constant once unrolled).
+int soft_slot(int i) {
+    return bitCount(SOFT_LIGHTS & ((1 << i) - 1));
+}
+
+// The atlas point (u, v, depth) light i looks up for x (surface normal ng,
+// direction l to the light, dist to a point light), with the acne offsets.
+vec4 shadow_point(int i, vec3 x, vec3 ng, vec3 l, float dist) {
+    float texel = frame.light_color[i].w * (frame.light_vec[i].w > 0.5 ? dist : 1.0);
+    vec3 side = dot(ng, l) < 0.0 ? -ng : ng;
+    vec3 p = x + texel * (NORMAL_OFFSET_TEXELS * side + LIGHT_OFFSET_TEXELS * l);
+    vec4 s = frame.light_shadow[i] * vec4(p, 1.0);
+    return vec4(s.xyz / s.w, 1.0);
+}
+
+#ifdef SHADOW_DEPTH
+layout(binding = SHADOW_DEPTH) uniform sampler2D shadow_depth;
 
 // Receiver-plane depth slope (Isidoro 2006): d depth / d(atlas u, v) on the plane
 // through the shaded point with normal ng, seen by light i's (orthographic) map,
@@ -81,7 +102,10 @@ float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
             count += 1.0;
         }
     }
+    // No blocker: lit; every tap a blocker: the umbra (the filter, whose radius
+    // is at most the search's, would find the same).
     if (count == 0.0) return 1.0;
+    if (count == float(BLOCKER_TAPS)) return 0.0;
     float radius = clamp(distance / count * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float lit = 0.0;
     for (int k = 0; k < PCF_TAPS; ++k) {
@@ -91,16 +115,39 @@ float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
     return lit / float(PCF_TAPS);
 }
 
-// Fraction of light i that reaches x (surface normal ng) from direction l.
-float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
-    float texel = frame.light_color[i].w * (frame.light_vec[i].w > 0.5 ? dist : 1.0);
-    vec3 side = dot(ng, l) < 0.0 ? -ng : ng;
-    vec3 p = x + texel * (NORMAL_OFFSET_TEXELS * side + LIGHT_OFFSET_TEXELS * l);
-    vec4 s = frame.light_shadow[i] * vec4(p, 1.0);
-    s.xyz /= s.w;
+// Soft light i's visibility at x (normal ng), from the atlas.
+float soft_shadow(int i, vec3 x, vec3 ng) {
+    vec3 s = shadow_point(i, x, ng, frame.light_vec[i].xyz, 1.0).xyz;
+    if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
+    return soft_visibility(i, s, ng, 1.0 / vec2(textureSize(shadow_atlas, 0)));
+}
+#endif
+
+#ifdef SOFT_VISIBILITY
+layout(binding = SOFT_VISIBILITY) uniform sampler2D soft_visibility0;
+layout(binding = SOFT_VISIBILITY + 1) uniform sampler2D soft_visibility1;
+layout(binding = SOFT_VISIBILITY + 2) uniform sampler2D soft_visibility2;
+
+// Soft light i's visibility at texture coordinate uv, as light_visibility.frag
+// stored it: renormalised by coverage, so chart borders do not pull in the gutter.
+float stored_soft_visibility(int i, vec2 uv) {
+    int slot = soft_slot(i);
+    vec4 t = slot < 3 ? textureLod(soft_visibility0, uv, 0.0)
+           : slot < 6 ? textureLod(soft_visibility1, uv, 0.0)
+                      : textureLod(soft_visibility2, uv, 0.0);
+    return t[slot % 3] / max(t.a, 1e-3);
+}
+#endif
+
+// Fraction of light i that reaches x (surface normal ng, texture coordinate uv)
+// from direction l.
+float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
+#ifdef SOFT_VISIBILITY
+    if ((SOFT_LIGHTS & (1 << i)) != 0) return stored_soft_visibility(i, uv);
+#endif
+    vec3 s = shadow_point(i, x, ng, l, dist).xyz;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
     vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
-    if ((SOFT_LIGHTS & (1 << i)) != 0) return soft_visibility(i, s.xyz, ng, step);
     float lit = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -110,10 +157,11 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     return lit / 9.0;
 }
 
-// Irradiance light i delivers at x to a surface facing it (shadowed; mirrors
-// scene::Light::at); l: the unit direction towards the light. 0 where the
-// shading normal n faces away from it (its shadow is not looked up there).
-vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, out vec3 l) {
+// Irradiance light i delivers at x (texture coordinate uv) to a surface facing
+// it (shadowed; mirrors scene::Light::at); l: the unit direction towards the
+// light. 0 where the shading normal n faces away from it (its shadow is not
+// looked up there).
+vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, vec2 uv, out vec3 l) {
     vec4 lv = frame.light_vec[i];
     vec3 e = frame.light_color[i].rgb;
     float dist = 1.0;
@@ -127,7 +175,7 @@ vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, out vec3 l) {
         l = lv.xyz;
     }
     if (dot(n, l) <= 0.0) return vec3(0.0);
-    if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, l, dist);
+    if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, uv, l, dist);
     return e;
 }
 

@@ -48,7 +48,9 @@ impl DirectPass {
     }
 
     /// Draws the mesh over `hdr`; `sh`: the environment's coefficients
-    /// (light::sh_pass); `shadows`: the lights' shadow atlas (light::shadow).
+    /// (light::sh_pass); `shadows`: the lights' shadow atlas (light::shadow);
+    /// `soft`: the soft lights' visibility (light::visibility).
+    #[allow(clippy::too_many_arguments)]
     pub fn pass(
         &self,
         g: &mut Graph,
@@ -56,6 +58,7 @@ impl DirectPass {
         inputs: &FrameInputs,
         sh: &BufferHandle,
         shadows: &ImageHandle,
+        soft: &[ImageHandle],
         hdr: &mut ImageHandle,
     ) {
         let (pipeline, name) = match view {
@@ -65,15 +68,18 @@ impl DirectPass {
         let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
         let s = &inputs.samplers;
-        let pass = g
+        let mut pass = g
             .simple_pass(name, pipeline)
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
             .read_uniform(sh)
             .buffer(&inputs.transfer)
-            .sample(shadows, &s.shadow)
-            .sample(shadows, &s.nearest)
+            .sample(shadows, &s.shadow);
+        for v in soft {
+            pass = pass.sample(v, &s.linear);
+        }
+        let pass = pass
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pass);

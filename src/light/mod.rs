@@ -10,3 +10,4 @@ pub mod sh;
 pub mod sh_pass;
 pub mod shadow;
 pub mod skybox;
+pub mod visibility;

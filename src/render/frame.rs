@@ -18,6 +18,7 @@ use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
 use crate::light::skybox::SkyboxPass;
+use crate::light::visibility::VisibilityPass;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::scene::file::{Gamma, Occlusion};
 use crate::scene::{Light, LightSource, Scene};
@@ -161,6 +162,7 @@ pub(super) struct Frame {
     blur: BlurChain,
     shade: ShadePass,
     shadow: ShadowPass,
+    visibility: VisibilityPass,
     /// The shadowed lights' projections, in atlas tile order.
     shadow_views: Vec<ShadowView>,
     shadow_resolution: u32,
@@ -293,6 +295,7 @@ impl Frame {
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx, &inputs.variant)?,
             shadow: ShadowPass::new(ctx)?,
+            visibility: VisibilityPass::new(ctx, &inputs.variant)?,
             shadow_views: views.into_iter().flatten().collect(),
             shadow_resolution: scene.file.render.shadow_resolution,
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
@@ -358,6 +361,9 @@ impl Frame {
             &self.shadow_views,
             self.shadow_resolution,
         );
+        let soft = self
+            .visibility
+            .pass(g, &self.inputs, &shadows, self.skin.resolution);
         if let View::Direct | View::Occlusion = view {
             let direct = match view {
                 View::Direct => DirectView::Shading,
@@ -365,7 +371,7 @@ impl Frame {
             };
             self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
             self.direct
-                .pass(g, direct, &self.inputs, &sh, &shadows, &mut hdr);
+                .pass(g, direct, &self.inputs, &sh, &shadows, &soft, &mut hdr);
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
@@ -375,7 +381,7 @@ impl Frame {
                 &self.inputs,
                 &self.tables,
                 &sh,
-                &shadows,
+                (&shadows, &soft),
                 res,
                 self.skin.mix,
             );
@@ -419,6 +425,7 @@ impl Frame {
                 ShadeImages {
                     levels: &levels,
                     shadows: &shadows,
+                    soft_visibility: &soft,
                     specular_env: &specular_env,
                 },
                 settings,

@@ -26,8 +26,9 @@ impl IrradiancePass {
     }
 
     /// `sh`: the environment's coefficients (light::sh_pass); `shadows`: the
-    /// lights' shadow atlas (light::shadow); `tables`: the specular term's, for
-    /// energy conservation on entry.
+    /// lights' shadow atlas (light::shadow) and `soft`, the soft lights'
+    /// visibility (light::visibility); `tables`: the specular term's, for energy
+    /// conservation on entry.
     #[allow(clippy::too_many_arguments)]
     pub fn pass(
         &self,
@@ -35,7 +36,7 @@ impl IrradiancePass {
         inputs: &FrameInputs,
         tables: &SpecularTables,
         sh: &BufferHandle,
-        shadows: &ImageHandle,
+        (shadows, soft): (&ImageHandle, &[ImageHandle]),
         resolution: u32,
         mix: f32,
     ) -> ImageHandle {
@@ -51,11 +52,14 @@ impl IrradiancePass {
             .texture(&inputs.normal, &s.linear)
             .read_uniform(sh)
             .buffer(&inputs.transfer);
-        let pass = tables
+        let mut pass = tables
             .bind(pass, inputs)
             .sample(shadows, &s.shadow)
-            .texture(&tables.hemispherical, &tables.sampler)
-            .sample(shadows, &s.nearest)
+            .texture(&tables.hemispherical, &tables.sampler);
+        for v in soft {
+            pass = pass.sample(v, &s.linear);
+        }
+        let pass = pass
             .color(&mut out, LoadOp::Clear([0.0; 4]))
             .constants(&mix);
         inputs.mesh.draw(pass);

@@ -34,6 +34,8 @@ pub struct ShadeImages<'a> {
     pub levels: &'a [ImageHandle],
     /// The lights' shadow atlas (light::shadow).
     pub shadows: &'a ImageHandle,
+    /// The soft lights' visibility textures (light::visibility).
+    pub soft_visibility: &'a [ImageHandle],
     /// The KS-prefiltered environment (light::prefilter).
     pub specular_env: &'a ImageHandle,
 }
@@ -104,8 +106,8 @@ impl ShadePass {
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
-        // specular environment, six blur levels, the specular bindings, the atlas
-        // again as plain depth (soft shadows).
+        // specular environment, six blur levels, the specular bindings, the soft
+        // lights' visibility.
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -117,9 +119,11 @@ impl ShadePass {
         for level in images.levels {
             pass = pass.sample(level, &s.linear);
         }
-        let pass = tables
-            .bind(pass, inputs)
-            .sample(images.shadows, &s.nearest)
+        let mut pass = tables.bind(pass, inputs);
+        for v in images.soft_visibility {
+            pass = pass.sample(v, &s.linear);
+        }
+        let pass = pass
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {

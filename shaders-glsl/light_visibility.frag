@@ -1,0 +1,31 @@
+#version 460
+// The soft lights' visibility in texture space (light/visibility.rs): for every
+// light with an angular size, the fraction of its source that reaches the surface
+// (percentage-closer soft shadows, common/lights.glsl), three lights per target,
+// premultiplied by coverage (alpha 1 on the mesh, 0 in the gutter) so that the
+// shading passes renormalise where bilinear taps reach past a chart's border.
+#extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+#define SHADOW_ATLAS 1
+#define SHADOW_DEPTH 2
+#include "lights.glsl"
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec2 v_uv;
+layout(location = 3) in vec4 v_tangent;
+layout(location = 0) out vec4 visibility0;
+layout(location = 1) out vec4 visibility1;
+layout(location = 2) out vec4 visibility2;
+
+void main() {
+    vec3 ng = normalize(v_normal);
+    float v[9] = float[9](1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0);
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
+        if ((SOFT_LIGHTS & (1 << i)) == 0) continue;
+        // Well past the terminator no normal map turns the surface to the light.
+        v[soft_slot(i)] = dot(ng, frame.light_vec[i].xyz) < -0.5 ? 0.0 : soft_shadow(i, v_position, ng);
+    }
+    visibility0 = vec4(v[0], v[1], v[2], 1.0);
+    visibility1 = vec4(v[3], v[4], v[5], 1.0);
+    visibility2 = vec4(v[6], v[7], v[8], 1.0);
+}

@@ -1,0 +1,91 @@
+//! The soft lights' visibility in texture space, once per frame: for each light
+//! with an angular size (the environment's extracted sources), percentage-closer
+//! soft shadows from its tile of the shadow atlas at every texel of the mesh's
+//! UV layout (shaders-glsl/light_visibility.frag). The shading passes (irradiance,
+//! final skin, direct view) read it back with one bilinear fetch per three lights,
+//! so the soft shadows' taps are paid at most [`MAX_RESOLUTION`]² times a frame,
+//! whatever the irradiance resolution and the screen.
+
+use crate::error::Result;
+use crate::frame::{FrameInputs, ShaderVariant, Vertex};
+use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::graph::{Graph, ImageHandle, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+/// Largest side of the visibility textures. The diffusion blurs the irradiance
+/// they shadow; 1024² is ~0.6 mm per texel on the scan, the shadow atlas's
+/// 2048² tiles ~0.25 mm.
+pub const MAX_RESOLUTION: u32 = 1024;
+/// Three lights per texture (RGB), coverage in alpha, 8 bits each.
+pub const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// Textures the shaders bind (common/lights.glsl SOFT_VISIBILITY): nine lights,
+/// more than frame::MAX_LIGHTS.
+pub const TEXTURES: usize = 3;
+
+pub struct VisibilityPass {
+    pipeline: Arc<Pipeline>,
+    /// Any light has an angular size and a shadow map.
+    soft: bool,
+}
+
+impl VisibilityPass {
+    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                vertex: "uv.vert",
+                fragment: "light_visibility.frag",
+                color_formats: &[FORMAT; TEXTURES],
+                depth_format: None,
+                depth_write: true,
+                vertex_layout: Some(Vertex::layout()),
+                // UV charts may be mirrored: both windings are surface.
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &variant.specialization(),
+            },
+        )?;
+        Ok(Self {
+            pipeline,
+            soft: variant.soft != 0,
+        })
+    }
+
+    /// The visibility textures at min(`resolution`, [`MAX_RESOLUTION`])², from the
+    /// lights' shadow `atlas` (light::shadow); three cleared 1×1 textures when no
+    /// light is soft, so the shading passes always have them to bind.
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        inputs: &FrameInputs,
+        atlas: &ImageHandle,
+        resolution: u32,
+    ) -> [ImageHandle; TEXTURES] {
+        let side = if self.soft {
+            resolution.min(MAX_RESOLUTION)
+        } else {
+            1
+        };
+        let mut out: [ImageHandle; TEXTURES] = std::array::from_fn(|k| {
+            g.create_image(
+                &format!("soft visibility {k}"),
+                ImageDesc::new(side, side, FORMAT),
+            )
+        });
+        let s = &inputs.samplers;
+        let mut pass = g
+            .simple_pass("light_visibility", &self.pipeline)
+            .uniform(&inputs.uniforms)
+            .sample(atlas, &s.shadow)
+            .sample(atlas, &s.nearest);
+        for image in &mut out {
+            pass = pass.color(image, LoadOp::Clear([0.0; 4]));
+        }
+        if self.soft {
+            inputs.mesh.draw(pass);
+        } else {
+            pass.record(|_| {});
+        }
+        out
+    }
+}
