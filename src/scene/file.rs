@@ -380,6 +380,10 @@ pub struct Light {
     /// Casts shadows through the shadow/depth pass.
     #[serde(default = "yes")]
     pub shadow: bool,
+    /// Directional: the source's angular diameter, degrees (the sun: 0.53);
+    /// 0 is a parallel beam. It softens the shadow and widens the highlight.
+    #[serde(default)]
+    pub angular_diameter_deg: f32,
 }
 
 fn white() -> [f32; 3] {
@@ -793,8 +797,21 @@ impl Light {
                     format!("{key}.direction is required for a directional light")
                 })?;
                 nonzero3(&format!("{key}.direction"), d)?;
+                // A cap wider than 40° is no longer one direction (its cosine
+                // lobe and shadow would be far off).
+                in_range(
+                    &format!("{key}.angular_diameter_deg"),
+                    self.angular_diameter_deg,
+                    0.0,
+                    40.0,
+                )?;
             }
             LightKind::Point => {
+                if self.angular_diameter_deg != 0.0 {
+                    return Err(format!(
+                        "{key}.angular_diameter_deg: only directional lights have an angular size"
+                    ));
+                }
                 if self.direction.is_some() {
                     return Err(format!(
                         "{key}.direction: a point light has a position, not a direction"
@@ -1014,6 +1031,7 @@ kind = "directional"
 direction = [0, -1, -1]
 color = [1, 0.9, 0.8]
 intensity = 3
+angular_diameter_deg = 0.53
 
 [[lights]]
 kind = "point"
@@ -1054,6 +1072,8 @@ gamma = 2.2
         assert_eq!(s.lights.len(), 2);
         assert_eq!(s.lights[0].kind, LightKind::Directional);
         assert!(s.lights[0].shadow);
+        assert_eq!(s.lights[0].angular_diameter_deg, 0.53);
+        assert_eq!(s.lights[1].angular_diameter_deg, 0.0);
         assert_eq!(s.lights[1].color, [1.0, 1.0, 1.0]);
         assert!(!s.lights[1].shadow);
         assert_eq!(s.skin.kernel, Kernel::Accurate);
@@ -1284,6 +1304,14 @@ gamma = 2.2
             (
                 "[skin]\nregions = [{ name = \"a\", rho_s = 0.2, m = 0.3 }]",
                 "exactly 10",
+            ),
+            (
+                "[[lights]]\nkind = \"directional\"\ndirection = [0, -1, 0]\nangular_diameter_deg = 50",
+                "lights[0].angular_diameter_deg = 50",
+            ),
+            (
+                "[[lights]]\nkind = \"point\"\nposition = [0, 0, 500]\nangular_diameter_deg = 1",
+                "only directional lights",
             ),
             ("[camera]\nfov_deg = 1", "camera.fov_deg = 1"),
             ("[camera]\nfov_deg = 179", "camera.fov_deg = 179"),

@@ -226,7 +226,7 @@ impl Scene {
                 },
                 irradiance: Vec3::from(l.color) * l.intensity,
                 shadow: l.shadow,
-                angular_radius: 0.0,
+                angular_radius: 0.5 * l.angular_diameter_deg.to_radians(),
             })
             .collect();
         Ok(Scene {
