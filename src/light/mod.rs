@@ -4,6 +4,7 @@
 pub mod direct;
 pub mod occlusion;
 pub mod prefilter;
+pub mod reference;
 pub mod sh;
 pub mod sh_pass;
 pub mod shadow;

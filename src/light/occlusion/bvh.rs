@@ -507,7 +507,7 @@ mod tests {
     }
 
     /// Closest hit of a ray by testing every input triangle (Möller–Trumbore
-    /// written out again here), as (t, input index, hit point).
+    /// written out again here, inside-edge form), as (t, input index).
     fn closest_brute_force(tris: &[[Vec3; 3]], o: Vec3, d: Vec3) -> Option<(f32, usize)> {
         let mut best: Option<(f32, usize)> = None;
         for (k, [a, b, c]) in tris.iter().enumerate() {
