@@ -148,6 +148,11 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// The mesh's BVH (for primary rays).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
     /// E at `x` for the unit normal `n`; `ng`: the unit geometric normal (either
     /// side) that shadow rays are lifted along; `index`: the point's number,
     /// which with the seed fixes its random stream.
