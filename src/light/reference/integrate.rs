@@ -464,4 +464,45 @@ mod tests {
         );
         assert!((luminance(mean) - luminance(want)).abs() < 4.0 * se);
     }
+
+    #[test]
+    fn lights_are_lambert_and_shadowed_by_rays() {
+        let mesh = floor_and_wall(1e4);
+        let env = EnvMap::uniform(Vec3::ZERO, 64, 32);
+        let x = Vec3::new(-100.0, 0.0, 0.0); // on the floor, 100 mm in front of the wall
+        let colour = Vec3::new(1.0, 0.5, 0.25);
+        let directional = |to_light: Vec3, shadow| Light {
+            source: LightSource::Directional(to_light.normalize()),
+            irradiance: colour,
+            shadow,
+        };
+        // From the front at 60° from the normal: cos = 0.5.
+        let front = directional(Vec3::new(-3f32.sqrt(), 1.0, 0.0), true);
+        // From behind the wall: blocked, unless it casts no shadow.
+        let behind = directional(Vec3::new(3f32.sqrt(), 1.0, 0.0), true);
+        let behind_unshadowed = directional(Vec3::new(3f32.sqrt(), 1.0, 0.0), false);
+        // A point light 500 mm straight above: irradiance at 1000 mm × (1000/500)².
+        let above = Light {
+            source: LightSource::Point(x + Vec3::Y * 500.0),
+            irradiance: colour,
+            shadow: true,
+        };
+        let settings = Settings::default();
+        for (lights, want) in [
+            (vec![front], 0.5 * colour),
+            (vec![behind], Vec3::ZERO),
+            (vec![behind_unshadowed], 0.5 * colour),
+            (vec![above], 4.0 * colour),
+            (vec![front, behind, above], 4.5 * colour),
+        ] {
+            let integrator = Integrator::new(&mesh, &env, 0.0, 1.0, &lights, &settings);
+            let e = integrator.irradiance(x, Vec3::Y, Vec3::Y, 0);
+            assert!(
+                (e.value - want).abs().max_element() < 1e-5,
+                "{e:?} vs {want}"
+            );
+            // A black sky adds nothing and no spread.
+            assert_eq!(e.rel_std_err, 0.0);
+        }
+    }
 }
