@@ -6,6 +6,7 @@ pub mod direct;
 pub mod extract;
 pub mod occlusion;
 pub mod prefilter;
+pub mod reference;
 pub mod sh;
 pub mod sh_pass;
 pub mod shadow;

@@ -26,7 +26,7 @@ mod raytrace;
 mod testutil;
 mod transfer;
 
-pub use bvh::Bvh;
+pub use bvh::{Bvh, Hit};
 pub use cache::{cache_key, default_cache_dir, load_cached, store_cached};
 pub use raytrace::{raytrace, RayOptions};
 pub use transfer::{unoccluded, Transfer};
