@@ -161,6 +161,38 @@ enum Command {
         #[arg(long)]
         replot: bool,
     },
+    /// Lighting against the truth: for each environment, the direct term
+    /// (`--view direct`, grey albedo) with the paper's SH9 alone and with the
+    /// bright sources extracted as shadowed lights, each against the CPU
+    /// reference (`--view reference`); prints the mean, median and 90th
+    /// percentile of the per-pixel relative error over the mesh (docs/lighting.md).
+    #[command(after_help = AFTER_HELP)]
+    Reference {
+        /// Scene file, or `builtin`; default: assets/default.toml. Its
+        /// environment is replaced by each of --envs.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// An environment (as --env of render); repeat for several. Default:
+        /// the scene's own.
+        #[arg(long = "env")]
+        envs: Vec<String>,
+        /// Image width in pixels.
+        #[arg(long, default_value_t = 96)]
+        width: u32,
+        /// Image height in pixels.
+        #[arg(long, default_value_t = 120)]
+        height: u32,
+        /// The reference's target relative standard error per pixel.
+        #[arg(long, default_value_t = 0.005)]
+        target_error: f32,
+        /// Directory for each environment's images (EXR) and a PNG of the
+        /// reference, SH9 and SH9 + lights side by side.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
     Render {
@@ -534,6 +566,59 @@ fn run(cli: Cli) -> dermis::Result<()> {
             println!("wrote {}", out_dir.display());
             Ok(())
         }
+        Command::Reference {
+            scene,
+            envs,
+            width,
+            height,
+            target_error,
+            out_dir,
+            json,
+        } => {
+            let file = scene_by_name(scene.as_deref())?;
+            let environments = if envs.is_empty() {
+                vec![file.environment.source.clone()]
+            } else {
+                envs.iter()
+                    .map(|e| e.parse())
+                    .collect::<Result<Vec<_>, _>>()?
+            };
+            if !(target_error > 0.0 && target_error < 1.0) {
+                return Err(dermis::Error::Input(format!(
+                    "--target-error {target_error}: must be in (0, 1)"
+                )));
+            }
+            let opts = dermis::sweep::lighting::LightingOptions {
+                scene: file,
+                environments,
+                width,
+                height,
+                settings: dermis::light::reference::Settings {
+                    target_rel_err: target_error,
+                    ..Default::default()
+                },
+                out_dir,
+            };
+            let ctx = Context::new(&context)?;
+            let rows = dermis::sweep::lighting::run(&ctx, &opts, |r| {
+                if !json {
+                    eprintln!(
+                        "{}: {} light(s) extracted; mean error {:.1} % → {:.1} % (reference {:.0} s)",
+                        r.environment,
+                        r.extracted,
+                        100.0 * r.sh9.mean,
+                        100.0 * r.sh9_lights.mean,
+                        r.reference_seconds
+                    );
+                }
+            })?;
+            if json {
+                println!("{}", to_json(Path::new("stdout"), &rows)?);
+            } else {
+                print!("{}", dermis::sweep::lighting::table(&rows));
+            }
+            Ok(())
+        }
         Command::Render {
             scene,
             out,
@@ -591,6 +676,17 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 print!("{}", output.plan);
             }
             dermis::render::output::write(&out, &output)?;
+            if let Some(r) = &output.reference {
+                eprintln!(
+                    "reference: {} mesh pixels, {:.1} % converged to 0.5 %, mean standard error \
+                     {:.2} %, {:.0} directions per pixel, {:.1} s",
+                    r.mesh_pixels,
+                    100.0 * r.converged,
+                    100.0 * r.mean_rel_std_err,
+                    r.samples as f64 / f64::from(r.mesh_pixels.max(1)),
+                    r.seconds
+                );
+            }
             let r = &output.report;
             if timings {
                 print!("{}{}", r.header(), r.table());

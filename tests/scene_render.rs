@@ -379,6 +379,7 @@ fn scattering_bleeds_red_into_the_shadow_edge() {
         color: [1.0, 1.0, 1.0],
         intensity: 3.0,
         shadow: false,
+        angular_diameter_deg: 0.0,
     }];
     file.render.width = 256;
     file.render.height = 256;

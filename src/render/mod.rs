@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, DeviceInfo};
 use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph};
+use crate::light::reference::{render_view, ReferenceImage, Settings as ReferenceSettings};
 use crate::post::tonemap::encode8;
 use crate::profile::{MemoryUse, RunReport, RunSetup};
 use crate::scene::file::{Chain, Kernel, Occlusion, SceneFile};
@@ -105,6 +106,9 @@ fn setup(
 pub struct RenderOutput {
     pub width: u32,
     pub height: u32,
+    /// `--view reference`: how the CPU reference converged (its pixels are in
+    /// `rgba8` and `hdr`; `rgba` here is empty).
+    pub reference: Option<ReferenceImage>,
     /// sRGB-encoded RGBA8, row-major, top row first.
     pub rgba8: Vec<u8>,
     /// Linear RGBA radiance × 2^exposure, when asked for.
@@ -146,6 +150,9 @@ pub fn render_scene(
     check_target(&ctx.info, screen.0, screen.1)?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
+    if opts.view == View::Reference {
+        return reference(ctx, scene, opts, skin.resolution);
+    }
     let resolution = skin.resolution;
     let frame = Frame::new(ctx, scene, skin, opts.ruler)?;
     let run_setup = setup(scene, opts, resolution, frame.extracted_lights);
@@ -227,10 +234,45 @@ pub fn render_scene(
     Ok(RenderOutput {
         width: w,
         height: h,
+        reference: None,
         rgba8,
         hdr,
         report,
         plan,
+    })
+}
+
+/// `--view reference`: the CPU reference of the direct view
+/// (light::reference::render_view), exposed and encoded like the GPU's image;
+/// its report has no passes.
+fn reference(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    opts: &RenderOptions,
+    resolution: u32,
+) -> Result<RenderOutput> {
+    let (w, h) = (scene.file.render.width, scene.file.render.height);
+    let mut image = render_view(scene, w, h, &ReferenceSettings::default())?;
+    let exposure = scene.exposure();
+    let rgba8 = encode8(&image.rgba, exposure, scene.file.render.gamma);
+    let scale = exposure.exp2();
+    let hdr = opts.hdr.then(|| {
+        image
+            .rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
+            .collect()
+    });
+    image.rgba = Vec::new();
+    let setup = setup(scene, opts, resolution, 0);
+    Ok(RenderOutput {
+        width: w,
+        height: h,
+        reference: Some(image),
+        rgba8,
+        hdr,
+        report: RunReport::new(&ctx.info, setup, w, h, Vec::new(), MemoryUse::default()),
+        plan: String::new(),
     })
 }
 

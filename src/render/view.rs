@@ -14,6 +14,9 @@ pub enum View {
     Specular,
     /// Direct diffuse shading in screen space, no scattering (for comparison).
     Direct,
+    /// The same quantity integrated on the CPU by Monte Carlo against the full
+    /// environment map with ray-cast visibility (light::reference): slow, offline.
+    Reference,
     /// The per-vertex transfer's DC term relative to open sky (1 = unoccluded).
     Occlusion,
     /// UV-space irradiance (coverage-premultiplied, as stored).
@@ -29,11 +32,12 @@ pub enum View {
 
 impl View {
     /// Every view, in the order `--help` lists them.
-    pub const ALL: [View; 14] = [
+    pub const ALL: [View; 15] = [
         View::Final,
         View::Diffuse,
         View::Specular,
         View::Direct,
+        View::Reference,
         View::Occlusion,
         View::Irradiance,
         View::Stretch,
@@ -53,6 +57,7 @@ impl View {
             View::Diffuse => "diffuse",
             View::Specular => "specular",
             View::Direct => "direct",
+            View::Reference => "reference",
             View::Occlusion => "occlusion",
             View::Irradiance => "irradiance",
             View::Stretch => "stretch",

@@ -66,7 +66,10 @@ pub fn compare(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<ImageE
 
 /// Per-pixel relative error of an image's luminance against a reference's, over
 /// a mask: |a − r| / max(r, floor), floor = [`RELATIVE_FLOOR`] × the mean
-/// reference luminance, so deep shadows (r → 0) do not divide by nothing.
+/// reference luminance, so deep shadows (r → 0) do not divide by nothing: a
+/// pixel darker than a tenth of the mean is judged against that tenth, as
+/// relative-MSE metrics add an ε of a few % of the image's level (Rousselle et
+/// al. 2011 use 0.01 on images of mean ~0.2–0.5).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RelativeError {
     pub mean: f64,
@@ -78,7 +81,7 @@ pub struct RelativeError {
 }
 
 /// The floor of [`RelativeError`]'s denominator, as a share of the mean.
-pub const RELATIVE_FLOOR: f64 = 0.02;
+pub const RELATIVE_FLOOR: f64 = 0.1;
 
 /// Rec. 709 luminance of an RGBA pixel.
 fn luminance(p: &[f32]) -> f64 {
@@ -182,11 +185,11 @@ mod tests {
             "{e:?}"
         );
         assert_eq!((e.within_5_percent, e.pixels), (0.0, 4));
-        // A pixel black in the reference divides by the floor, 2 % of the mean.
+        // A pixel black in the reference divides by the floor, 10 % of the mean.
         let r = image(2, |x| [0.0, 2.0][x], |_| 1.0);
         let a = image(2, |x| [0.01, 2.0][x], |_| 1.0);
         let e = relative(&r, &a, &coverage_mask(&r)).unwrap();
-        assert!((e.mean - 0.5 * 0.01 / (0.02 * 1.0)).abs() < 1e-6, "{e:?}");
+        assert!((e.mean - 0.5 * 0.01 / (0.1 * 1.0)).abs() < 1e-6, "{e:?}");
     }
 
     #[test]

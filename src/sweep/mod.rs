@@ -3,6 +3,7 @@
 //! final image and the diffuse term with a reference (by default 4096², accurate
 //! kernel, full chain) over the face. Writes a CSV, a JSON and plots.
 
+pub mod lighting;
 pub mod metric;
 pub mod plot;
 

@@ -24,8 +24,8 @@ use crate::scene::env::{direction_to_uv, texel_solid_angle_f64, EnvMap};
 pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 
 /// The sampling distribution of one environment map.
-pub struct EnvSampler<'a> {
-    env: &'a EnvMap,
+pub struct EnvSampler {
+    env: EnvMap,
     /// `height + 1` entries: the CDF over rows, 0 … 1.
     marginal: Vec<f64>,
     /// `height` rows of `width + 1` entries: each row's CDF over columns, 0 … 1.
@@ -34,9 +34,9 @@ pub struct EnvSampler<'a> {
     total: f64,
 }
 
-impl<'a> EnvSampler<'a> {
+impl EnvSampler {
     /// The distribution of `env` (a sanitized map: no negative or non-finite texels).
-    pub fn new(env: &'a EnvMap) -> EnvSampler<'a> {
+    pub fn new(env: EnvMap) -> EnvSampler {
         let (w, h) = (env.width as usize, env.height as usize);
         let mut conditional = Vec::with_capacity(h * (w + 1));
         let mut row_weights = Vec::with_capacity(h);
@@ -71,6 +71,11 @@ impl<'a> EnvSampler<'a> {
             conditional,
             total,
         }
+    }
+
+    /// Whether the map is black (nothing to sample).
+    pub fn is_black(&self) -> bool {
+        self.total == 0.0
     }
 
     /// A direction (map frame, unit) for the uniform numbers `u1, u2 ∈ [0, 1)`,
@@ -205,10 +210,10 @@ mod tests {
             sum
         };
         let env = test_map(4.0, true);
-        let s = EnvSampler::new(&env);
+        let s = EnvSampler::new(env.clone());
         let i = integrate(&s);
         let black = EnvMap::uniform(Vec3::ZERO, 32, 16);
-        let b = integrate(&EnvSampler::new(&black));
+        let b = integrate(&EnvSampler::new(black.clone()));
         println!(
             "∫ pdf dω − 1 = {:.1e} (luminance map), {:.1e} (black map)",
             i - 1.0,
@@ -220,7 +225,7 @@ mod tests {
     #[test]
     fn histogram_follows_luminance_times_solid_angle() {
         let env = test_map(4.0, true);
-        let s = EnvSampler::new(&env);
+        let s = EnvSampler::new(env.clone());
         let weight = |x: u32, y: u32| {
             f64::from(luminance(env.texel(x, y))) * texel_solid_angle_f64(y, 32, 16)
         };
@@ -277,7 +282,7 @@ mod tests {
         // texel, so p > 0 everywhere, and a narrow range, so f/p varies little):
         // ∫ max(0, y)·x² dω = ∫_0^{π/2} cos θ sin³θ dθ · ∫ sin²φ dφ = π/4.
         let env = test_map(0.5, false);
-        let s = EnvSampler::new(&env);
+        let s = EnvSampler::new(env.clone());
         let mut rng = Rng::new(5);
         let n = 1 << 20;
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
@@ -300,7 +305,7 @@ mod tests {
     #[test]
     fn black_map_samples_the_sphere_uniformly() {
         let env = EnvMap::uniform(Vec3::ZERO, 16, 8);
-        let s = EnvSampler::new(&env);
+        let s = EnvSampler::new(env.clone());
         let mut rng = Rng::new(2);
         let n = 100_000;
         let (mut mean, mut y2) = (Vec3::ZERO, 0.0);

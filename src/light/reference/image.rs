@@ -175,10 +175,25 @@ fn shade(
         normal.normalize_or(geometric)
     };
     // Two-sided by the interpolated vertex normal, as forward.frag.
-    if normal.dot(scene.camera.position - x) < 0.0 {
+    let side = if normal.dot(scene.camera.position - x) < 0.0 {
         n = -n;
-    }
-    let e = integrator.irradiance(x, n, geometric, index);
+        -1.0
+    } else {
+        1.0
+    };
+    // Shadow rays leave from the smooth surface the vertex normals describe,
+    // not the flat triangle, else smooth shading shows the facets where a
+    // light grazes them (the shadow terminator; Hanika 2021, "Hacking the
+    // shadow terminator"): x is lifted to each corner's tangent plane where it
+    // lies below it, blended barycentrically.
+    let lift: Vec3 = [(i0, b.x), (i1, b.y), (i2, b.z)]
+        .iter()
+        .map(|&(i, w)| {
+            let ni = mesh.normals[i].normalize_or_zero() * side;
+            -w * (x - mesh.positions[i]).dot(ni).min(0.0) * ni
+        })
+        .sum();
+    let e = integrator.irradiance(x + lift, n, geometric, index);
     let albedo = texture::rgba8(&scene.albedo, uv).xyz();
     (
         (albedo / PI * e.value).extend(1.0),
