@@ -368,6 +368,9 @@ fn soft_shadows_follow_the_source_size() {
     let alpha = 4f32.to_radians();
     let s = ShadowScene::new();
     let mut scene = s.scene;
+    // The visibility texture is half the irradiance resolution; the big sphere
+    // has half of it: 512 texels around its 377 mm equator.
+    scene.file.render.irradiance_resolution = 2048;
     let dir = (s.small.0 - s.big.0)
         .normalize()
         .lerp(Vec3::Y, 0.15)

@@ -3,8 +3,8 @@
 //! soft shadows from its tile of the shadow atlas at every texel of the mesh's
 //! UV layout (shaders-glsl/light_visibility.frag). The shading passes (irradiance,
 //! final skin, direct view) read it back with one bilinear fetch per three lights,
-//! so the soft shadows' taps are paid at most [`MAX_RESOLUTION`]² times a frame,
-//! whatever the irradiance resolution and the screen.
+//! so the soft shadows' taps are paid at half the irradiance resolution, at most
+//! [`MAX_RESOLUTION`]², whatever the screen.
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex};
@@ -15,7 +15,8 @@ use std::sync::Arc;
 
 /// Largest side of the visibility textures. The diffusion blurs the irradiance
 /// they shadow; 1024² is ~0.6 mm per texel on the scan, the shadow atlas's
-/// 2048² tiles ~0.25 mm.
+/// 2048² tiles ~0.25 mm. Half the irradiance resolution costs no measurable
+/// accuracy against the reference (docs/lighting.md) and a quarter of the time.
 pub const MAX_RESOLUTION: u32 = 1024;
 /// Three lights per texture (RGB), coverage in alpha, 8 bits each.
 pub const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
@@ -51,7 +52,7 @@ impl VisibilityPass {
         })
     }
 
-    /// The visibility textures at min(`resolution`, [`MAX_RESOLUTION`])², from the
+    /// The visibility textures at min(`resolution`/2, [`MAX_RESOLUTION`])², from the
     /// lights' shadow `atlas` (light::shadow); three cleared 1×1 textures when no
     /// light is soft, so the shading passes always have them to bind.
     pub fn pass(
@@ -62,7 +63,7 @@ impl VisibilityPass {
         resolution: u32,
     ) -> [ImageHandle; TEXTURES] {
         let side = if self.soft {
-            resolution.min(MAX_RESOLUTION)
+            (resolution / 2).clamp(1, MAX_RESOLUTION)
         } else {
             1
         };
