@@ -32,6 +32,9 @@ pub enum Error {
     },
     #[error("render graph: {0}")]
     Graph(String),
+    /// No display, no window, no surface the device can present to.
+    #[error("window system: {0}")]
+    Window(String),
     /// Bad user input (files, sizes, options): exit status 2.
     #[error("{0}")]
     Input(String),

@@ -53,6 +53,7 @@ impl TestScene {
                     vertex_layout: None,
                     cull_mode: vk::CullModeFlags::NONE,
                     specialization: &[],
+                    alpha_blend: false,
                 },
             )
         };

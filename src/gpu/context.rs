@@ -19,6 +19,9 @@ pub struct ContextOptions {
     pub validation: bool,
     /// Pick the first device whose name contains this (case-insensitive).
     pub device: Option<String>,
+    /// Present to windows of this display (the viewer): the instance gets the
+    /// display's surface extensions and the device VK_KHR_swapchain.
+    pub display: Option<raw_window_handle::RawDisplayHandle>,
 }
 
 impl ContextOptions {
@@ -29,6 +32,7 @@ impl ContextOptions {
             device: std::env::var("DERMIS_DEVICE")
                 .ok()
                 .filter(|s| !s.is_empty()),
+            display: None,
         }
     }
 }
@@ -58,7 +62,7 @@ pub struct MemoryHeap {
 }
 
 pub struct Context {
-    _entry: ash::Entry,
+    pub(crate) entry: ash::Entry,
     pub instance: ash::Instance,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
@@ -119,15 +123,29 @@ impl Context {
         let validation = options
             .validation
             .then(|| Arc::new(ValidationLog::default()));
-        let (instance, messenger) = create_instance(&entry, validation.as_deref())?;
+        let surface_extensions = match options.display {
+            Some(display) => ash_window::enumerate_required_extensions(display)
+                .map_err(|e| {
+                    Error::Window(format!("no Vulkan surface extension for this display: {e}"))
+                })?
+                .to_vec(),
+            None => Vec::new(),
+        };
+        let (instance, messenger) =
+            create_instance(&entry, validation.as_deref(), &surface_extensions)?;
         // From here on, `partial` destroys what exists if a later step fails.
         let partial = Partial {
             instance: &instance,
             messenger: messenger.as_ref(),
         };
-        let (physical, queue_family, info) =
-            choose_device(&instance, options.device.as_deref(), validation.is_some())?;
-        let device = create_device(&instance, physical, queue_family)?;
+        let swapchain = options.display.is_some();
+        let (physical, queue_family, info) = choose_device(
+            &instance,
+            options.device.as_deref(),
+            validation.is_some(),
+            swapchain,
+        )?;
+        let device = create_device(&instance, physical, queue_family, swapchain)?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -162,7 +180,7 @@ impl Context {
             info.api_version
         );
         Ok(Arc::new(Self {
-            _entry: entry,
+            entry,
             instance,
             messenger,
             debug_utils,
@@ -268,13 +286,14 @@ type Messenger = (ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT);
 fn create_instance(
     entry: &ash::Entry,
     validation: Option<&ValidationLog>,
+    surface_extensions: &[*const c_char],
 ) -> Result<(ash::Instance, Option<Messenger>)> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"dermis")
         .engine_name(c"dermis")
         .api_version(vk::API_VERSION_1_3);
     let mut layers: Vec<*const c_char> = Vec::new();
-    let mut extensions: Vec<*const c_char> = Vec::new();
+    let mut extensions: Vec<*const c_char> = surface_extensions.to_vec();
     if has_instance_extension(entry, ash::ext::debug_utils::NAME) || validation.is_some() {
         extensions.push(ash::ext::debug_utils::NAME.as_ptr());
     }
@@ -334,6 +353,7 @@ fn choose_device(
     instance: &ash::Instance,
     wanted: Option<&str>,
     validation: bool,
+    swapchain: bool,
 ) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
     let devices =
         unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
@@ -365,7 +385,7 @@ fn choose_device(
     candidates.sort_by_key(|c| c.0);
     let mut reasons = Vec::new();
     for (_, pd, name) in candidates {
-        match check_device(instance, pd) {
+        match check_device(instance, pd, swapchain) {
             Ok(family) => return Ok((pd, family, device_info(instance, pd, family, validation))),
             Err(why) => reasons.push(format!("{name}: {why}")),
         }
@@ -377,7 +397,11 @@ fn choose_device(
 }
 
 /// Returns the queue family to use, or why the device does not qualify.
-fn check_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<u32, String> {
+fn check_device(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    swapchain: bool,
+) -> Result<u32, String> {
     let props = unsafe { instance.get_physical_device_properties(pd) };
     if props.api_version < vk::API_VERSION_1_3 {
         return Err(format!(
@@ -392,6 +416,13 @@ fn check_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<u32,
         .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::push_descriptor::NAME))
     {
         return Err("no VK_KHR_push_descriptor".into());
+    }
+    if swapchain
+        && !exts
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::swapchain::NAME))
+    {
+        return Err("no VK_KHR_swapchain".into());
     }
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
@@ -456,12 +487,16 @@ fn create_device(
     instance: &ash::Instance,
     pd: vk::PhysicalDevice,
     family: u32,
+    swapchain: bool,
 ) -> Result<ash::Device> {
     let priorities = [1.0];
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(family)
         .queue_priorities(&priorities)];
-    let extensions = [ash::khr::push_descriptor::NAME.as_ptr()];
+    let mut extensions = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+    if swapchain {
+        extensions.push(ash::khr::swapchain::NAME.as_ptr());
+    }
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)

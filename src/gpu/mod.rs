@@ -6,6 +6,7 @@ mod pipeline;
 mod reflect;
 mod resources;
 pub mod shaders;
+mod swapchain;
 mod validation;
 
 pub use context::{Context, ContextOptions, DeviceInfo, MemoryHeap};
@@ -13,6 +14,7 @@ pub use pipeline::{GraphicsDesc, Pipeline};
 pub use reflect::ShaderLayout;
 pub(crate) use resources::full_range;
 pub use resources::{aspect, texel_bytes, Buffer, Image, ImageDesc, Sampler};
+pub use swapchain::{Acquired, Surface, Swapchain};
 pub use validation::ValidationLog;
 
 pub use gpu_allocator::MemoryLocation;

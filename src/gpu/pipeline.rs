@@ -21,6 +21,9 @@ pub struct GraphicsDesc<'a> {
     pub cull_mode: vk::CullModeFlags,
     /// Specialization constants of both stages: `constant_id = i` takes `[i]`.
     pub specialization: &'a [u32],
+    /// Blend premultiplied-alpha colour over the target (ONE, ONE_MINUS_SRC_ALPHA);
+    /// false: overwrite.
+    pub alpha_blend: bool,
 }
 
 /// Map entries for specialization constants 0..n, one 32-bit word each.
@@ -214,8 +217,21 @@ impl Pipeline {
             .color_formats
             .iter()
             .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+                let state = vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA);
+                if desc.alpha_blend {
+                    use vk::BlendFactor as F;
+                    state
+                        .blend_enable(true)
+                        .src_color_blend_factor(F::ONE)
+                        .dst_color_blend_factor(F::ONE_MINUS_SRC_ALPHA)
+                        .color_blend_op(vk::BlendOp::ADD)
+                        .src_alpha_blend_factor(F::ONE)
+                        .dst_alpha_blend_factor(F::ONE_MINUS_SRC_ALPHA)
+                        .alpha_blend_op(vk::BlendOp::ADD)
+                } else {
+                    state
+                }
             })
             .collect();
         let blend =

@@ -55,6 +55,8 @@ pub struct Image {
     pub desc: ImageDesc,
     pub usage: vk::ImageUsageFlags,
     allocation: Option<Allocation>,
+    /// The image is someone else's (a swapchain's): only the view is ours.
+    external: bool,
 }
 
 impl Image {
@@ -96,6 +98,7 @@ impl Image {
             desc,
             usage,
             allocation: None,
+            external: false,
         };
         let requirements = unsafe { device.get_image_memory_requirements(raw) };
         let allocation = ctx
@@ -122,6 +125,35 @@ impl Image {
         image.view =
             unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         ctx.name(raw, name);
+        ctx.name(image.view, name);
+        Ok(image)
+    }
+
+    /// An image another object owns (a swapchain's), with a view of our own so
+    /// the graph can use it like any other; dropping it destroys only the view.
+    pub fn external(
+        ctx: &Arc<Context>,
+        name: &str,
+        raw: vk::Image,
+        desc: ImageDesc,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self> {
+        let mut image = Image {
+            ctx: ctx.clone(),
+            raw,
+            view: vk::ImageView::null(),
+            desc,
+            usage,
+            allocation: None,
+            external: true,
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(desc.format)
+            .subresource_range(full_range(desc.format, desc.mip_levels));
+        image.view =
+            unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         ctx.name(image.view, name);
         Ok(image)
     }
@@ -152,7 +184,9 @@ impl Drop for Image {
             if self.view != vk::ImageView::null() {
                 self.ctx.device.destroy_image_view(self.view, None);
             }
-            self.ctx.device.destroy_image(self.raw, None);
+            if !self.external {
+                self.ctx.device.destroy_image(self.raw, None);
+            }
         }
         if let Some(a) = self.allocation.take() {
             let _ = self.ctx.allocator().free(a);

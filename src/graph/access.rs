@@ -41,6 +41,13 @@ pub enum Access {
     UniformRead,
     /// Read by the host after the frame's fence (e.g. readback).
     HostRead,
+    /// A swapchain image just acquired: the frame's submission waits on its
+    /// semaphore at the colour-attachment stage, which the first barrier chains
+    /// with; its contents are discarded. An import's initial access only.
+    Acquired,
+    /// Handed to the presentation engine (PRESENT_SRC_KHR); the frame's
+    /// submission signals the present's semaphore. An import's final access only.
+    Present,
 }
 
 /// What an access means to the synchronisation model.
@@ -157,6 +164,8 @@ impl Access {
                 false,
             ),
             Access::HostRead => (S::HOST, A::HOST_READ, L::UNDEFINED, false),
+            Access::Acquired => (S::COLOR_ATTACHMENT_OUTPUT, A::NONE, L::UNDEFINED, false),
+            Access::Present => (S::NONE, A::NONE, L::PRESENT_SRC_KHR, false),
         };
         AccessInfo {
             stages,

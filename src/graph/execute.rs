@@ -39,6 +39,14 @@ struct InFlight {
     _graph: Graph,
 }
 
+/// Semaphores a frame's work waits on (with the stage that waits) and signals:
+/// a swapchain image's acquire and present.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameSync {
+    pub wait: Option<(vk::Semaphore, vk::PipelineStageFlags2)>,
+    pub signal: Option<vk::Semaphore>,
+}
+
 /// Which clock measures passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -174,6 +182,17 @@ impl Executor {
     }
 
     pub fn submit(&mut self, compiled: Compiled) -> Result<Option<FrameReport>> {
+        self.submit_synced(compiled, FrameSync::default())
+    }
+
+    /// [`Executor::submit`] for a frame that draws a swapchain image: its work
+    /// waits on `sync.wait` and signals `sync.signal` (in host-fence mode the
+    /// first pass's submission waits and the last one's signals).
+    pub fn submit_synced(
+        &mut self,
+        compiled: Compiled,
+        sync: FrameSync,
+    ) -> Result<Option<FrameReport>> {
         let index = self.next;
         let previous = self.retire(index)?;
         self.realize_pool()?;
@@ -188,7 +207,8 @@ impl Executor {
         let n = names.len();
         let work: Vec<PassWork> = compiled.plan.passes.iter().map(|p| p.work).collect();
         if self.clock == Clock::HostFence {
-            let mut report = self.run_isolated(index, &compiled, &images, &buffers, names)?;
+            let mut report =
+                self.run_isolated(index, &compiled, &images, &buffers, names, sync)?;
             report.set_work(&work);
             self.frame += 1;
             return Ok(previous.or(Some(report)));
@@ -196,7 +216,7 @@ impl Executor {
         self.ensure_queries(index, 2 + 2 * n as u32)?;
         self.record(index, &compiled, &images, &buffers, 0..n)?;
         let recorded = Instant::now();
-        self.submit_slot(index)?;
+        self.submit_slot(index, sync)?;
         let submitted = Instant::now();
         self.slots[index].in_flight = Some(InFlight {
             frame: self.frame,
@@ -211,10 +231,31 @@ impl Executor {
         Ok(previous)
     }
 
-    fn submit_slot(&self, index: usize) -> Result<()> {
+    fn submit_slot(&self, index: usize, sync: FrameSync) -> Result<()> {
         let slot = &self.slots[index];
         let cmd_info = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
-        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmd_info)];
+        let waits: Vec<_> = sync
+            .wait
+            .iter()
+            .map(|&(s, stage)| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(stage)
+            })
+            .collect();
+        let signals: Vec<_> = sync
+            .signal
+            .iter()
+            .map(|&s| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+            })
+            .collect();
+        let submit = [vk::SubmitInfo2::default()
+            .command_buffer_infos(&cmd_info)
+            .wait_semaphore_infos(&waits)
+            .signal_semaphore_infos(&signals)];
         let queue = self.ctx.queue();
         unsafe { self.ctx.device.queue_submit2(*queue, &submit, slot.fence) }.vk("vkQueueSubmit2")
     }
@@ -228,6 +269,7 @@ impl Executor {
         images: &[Option<ResolvedImage>],
         buffers: &[Option<vk::Buffer>],
         names: Vec<String>,
+        sync: FrameSync,
     ) -> Result<FrameReport> {
         let fence = self.slots[index].fence;
         let d = &self.ctx.device;
@@ -235,11 +277,16 @@ impl Executor {
         let epoch = *self.host_epoch.get_or_insert(frame_start);
         let (mut record_ns, mut submit_ns) = (0.0, 0.0);
         let mut passes = Vec::with_capacity(names.len());
-        for i in 0..names.len().max(1) {
+        let count = names.len().max(1);
+        for i in 0..count {
             let t0 = Instant::now();
             self.record(index, c, images, buffers, i..(i + 1).min(names.len()))?;
             let t1 = Instant::now();
-            self.submit_slot(index)?;
+            let this = FrameSync {
+                wait: sync.wait.filter(|_| i == 0),
+                signal: sync.signal.filter(|_| i + 1 == count),
+            };
+            self.submit_slot(index, this)?;
             let t2 = Instant::now();
             unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")?;
             unsafe { d.reset_fences(&[fence]) }.vk("vkResetFences")?;

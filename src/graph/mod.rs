@@ -14,7 +14,7 @@ mod simple;
 pub mod upload;
 
 pub use access::{Access, AccessInfo};
-pub use execute::{Clock, Compiled, Executor};
+pub use execute::{Clock, Compiled, Executor, FrameSync};
 pub use pass_cx::{Descriptor, PassCx, ResolvedImage};
 pub use plan::{Barrier, Plan, PlannedPass, PlannedResource, PoolState};
 pub use simple::SimplePass;

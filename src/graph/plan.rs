@@ -737,6 +737,39 @@ mod tests {
     }
 
     #[test]
+    fn a_swapchain_image_is_drawn_after_its_acquire_and_left_for_present() {
+        let mut g = Graph::new();
+        let mut target = g.import_image(
+            "swapchain",
+            Imported::Described {
+                image: Some(ImageDesc::new(64, 64, vk::Format::B8G8R8A8_UNORM)),
+                buffer_size: 0,
+                image_usage: vk::ImageUsageFlags::COLOR_ATTACHMENT,
+                buffer_usage: vk::BufferUsageFlags::empty(),
+            },
+            Some(Access::Acquired),
+            Some(Access::Present),
+        );
+        let mut p = g.add_pass("ui");
+        p.color_attachment(&mut target, crate::graph::LoadOp::Clear([0.0; 4]));
+        p.record(|_| {});
+        let plan = g.compile(&mut PoolState::default()).unwrap();
+        let first = barriers_for(&plan, 0, 0)[0];
+        // Chains with the acquire semaphore's wait at the attachment stage.
+        assert_eq!((first.src_stage, first.src_access), (S::COLOR_ATTACHMENT_OUTPUT, A::NONE));
+        assert_eq!(
+            first.layouts,
+            Some((L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL))
+        );
+        let end = plan.final_barriers[0];
+        assert_eq!(end.src_stage, S::COLOR_ATTACHMENT_OUTPUT);
+        assert_eq!(
+            end.layouts,
+            Some((L::COLOR_ATTACHMENT_OPTIMAL, L::PRESENT_SRC_KHR))
+        );
+    }
+
+    #[test]
     fn declaration_errors_are_reported() {
         let mut g = Graph::new();
         let a = image(&mut g, "a");

@@ -38,6 +38,7 @@ impl DirectPass {
                     // Scanned meshes are not reliably closed or consistently wound.
                     cull_mode: vk::CullModeFlags::NONE,
                     specialization: &variant.specialization(),
+                    alpha_blend: false,
                 },
             )
         };

@@ -126,6 +126,7 @@ impl ShadowPass {
                 vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &[],
+                alpha_blend: false,
             },
         )?;
         Ok(Self { pipeline })

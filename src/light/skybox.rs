@@ -24,6 +24,7 @@ impl SkyboxPass {
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &[],
+                alpha_blend: false,
             },
         )?;
         Ok(Self { pipeline })

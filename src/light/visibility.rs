@@ -44,6 +44,7 @@ impl VisibilityPass {
                 // UV charts may be mirrored: both windings are surface.
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &variant.specialization(),
+                alpha_blend: false,
             },
         )?;
         Ok(Self {

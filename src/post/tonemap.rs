@@ -65,6 +65,7 @@ impl Tonemap {
                 vertex_layout: None,
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &[],
+                alpha_blend: false,
             },
         )?;
         Ok(Self { pipeline, sampler })

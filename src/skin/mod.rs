@@ -131,6 +131,7 @@ pub(crate) fn uv_pipeline(
             // UV charts may be mirrored: both windings are surface.
             cull_mode: vk::CullModeFlags::NONE,
             specialization,
+            alpha_blend: false,
         },
     )
 }

@@ -73,6 +73,7 @@ impl ShadePass {
                     vertex_layout: Some(Vertex::layout()),
                     cull_mode: vk::CullModeFlags::NONE,
                     specialization: &variant.specialization(),
+                    alpha_blend: false,
                 },
             )
         };

@@ -19,6 +19,7 @@ pub fn with_gpu_log<T>(f: impl FnOnce(&Arc<Context>) -> T) -> (T, Arc<Validation
     let ctx = Context::new(&ContextOptions {
         validation: true,
         device: std::env::var("DERMIS_DEVICE").ok(),
+        display: None,
     })
     .expect("a Vulkan device with VK_LAYER_KHRONOS_validation (see README)");
     let log = ctx.validation().expect("validation is on");

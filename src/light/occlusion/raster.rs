@@ -128,6 +128,7 @@ pub fn raster_vertices(
             vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
             cull_mode: vk::CullModeFlags::NONE,
             specialization: &[],
+            alpha_blend: false,
         },
     )?;
     let reduce = Pipeline::compute(ctx, "occlusion_reduce.comp")?;
