@@ -20,9 +20,11 @@ Environment:
   DERMIS_CACHE_DIR=DIR      occlusion transfer cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
   RUST_LOG=LEVEL            log filter (overrides -v)
   LP_NUM_THREADS=N          lavapipe's rasterizer threads (recorded in reports)
+  DISPLAY                   the X display `dermis view` opens its window on
 
 Exit status:
-  0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver).";
+  0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver,
+  window system).";
 
 #[derive(Parser)]
 #[command(
@@ -192,6 +194,39 @@ enum Command {
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
+    },
+    /// Open the interactive viewer: the scene in a window (winit, Vulkan
+    /// swapchain) with an orbit camera, the paper's controls and live per-pass
+    /// timings.
+    ///
+    /// Mouse and keys: left drag orbits, right or middle drag pans, the wheel
+    /// zooms; Shift + left drag turns the environment; right click opens the
+    /// controls; F12 writes a screenshot (PNG), R reloads the scene file, Esc
+    /// quits.
+    #[command(after_help = AFTER_HELP)]
+    View {
+        /// Scene file, or `builtin`; default: assets/default.toml.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Environment, replacing the scene's (as render --env).
+        #[arg(long)]
+        env: Option<String>,
+        /// Side of the UV-space irradiance texture, replacing the scene's.
+        #[arg(long)]
+        irradiance_res: Option<u32>,
+        /// Window width in pixels (default: the scene's render width).
+        #[arg(long)]
+        width: Option<u32>,
+        /// Window height in pixels (default: the scene's render height).
+        #[arg(long)]
+        height: Option<u32>,
+        /// Render N window frames and exit (resizing the window once halfway,
+        /// and waiting for the last render to be shown): for headless tests.
+        #[arg(long)]
+        frames: Option<u32>,
+        /// Where the last frame of a --frames run (and F12) writes its PNG.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
     },
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
@@ -618,6 +653,35 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 print!("{}", dermis::sweep::lighting::table(&rows));
             }
             Ok(())
+        }
+        Command::View {
+            scene,
+            env,
+            irradiance_res,
+            width,
+            height,
+            frames,
+            screenshot,
+        } => {
+            if frames == Some(0) {
+                return Err(dermis::Error::Input("--frames 0: give 1 or more".into()));
+            }
+            let overrides = Overrides {
+                env,
+                irradiance_resolution: irradiance_res,
+                width,
+                height,
+                ..Overrides::default()
+            };
+            let file = overrides.apply(scene_by_name(scene.as_deref())?)?;
+            dermis::viewer::run(dermis::viewer::ViewerOptions {
+                scene: file,
+                scene_path: scene,
+                overrides,
+                context,
+                frames,
+                screenshot,
+            })
         }
         Command::Render {
             scene,

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// its own layer's other modules or anything above.
 const LAYERS: &[&[&str]] = &[
     &["main"],
-    &["sweep"],
+    &["sweep", "viewer"],
     &["render"],
     &["post", "light"],
     &["skin"],

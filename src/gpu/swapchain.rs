@@ -19,9 +19,14 @@ pub struct Surface {
 impl Surface {
     /// The surface of `window` on `display`; the context must have been created
     /// for that display (`ContextOptions::display`).
-    pub fn new(ctx: &Arc<Context>, display: RawDisplayHandle, window: RawWindowHandle) -> Result<Self> {
-        let raw = unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None) }
-            .vk("vkCreateSurfaceKHR")?;
+    pub fn new(
+        ctx: &Arc<Context>,
+        display: RawDisplayHandle,
+        window: RawWindowHandle,
+    ) -> Result<Self> {
+        let raw =
+            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None) }
+                .vk("vkCreateSurfaceKHR")?;
         let surface = Surface {
             _ctx: ctx.clone(),
             loader: ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance),
@@ -120,7 +125,9 @@ impl Swapchain {
         if caps.max_image_count > 0 {
             count = count.min(caps.max_image_count);
         }
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT;
+        // Copies out serve screenshots, where the surface allows them.
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface.raw)
             .min_image_count(count)
@@ -150,16 +157,19 @@ impl Swapchain {
             rendered: Vec::new(),
             next: 0,
         };
-        let raws = unsafe { swapchain.loader.get_swapchain_images(raw) }
-            .vk("vkGetSwapchainImagesKHR")?;
+        let raws =
+            unsafe { swapchain.loader.get_swapchain_images(raw) }.vk("vkGetSwapchainImagesKHR")?;
         let desc = ImageDesc::new(extent.width, extent.height, chosen.format);
         for (i, &image) in raws.iter().enumerate() {
             let image = Image::external(ctx, &format!("swapchain {i}"), image, desc, usage)?;
             swapchain.images.push(Arc::new(image));
         }
         let semaphore = || {
-            unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
-                .vk("vkCreateSemaphore")
+            unsafe {
+                ctx.device
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            }
+            .vk("vkCreateSemaphore")
         };
         for _ in 0..=raws.len() {
             swapchain.ready.push(semaphore()?);

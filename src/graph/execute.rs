@@ -207,8 +207,7 @@ impl Executor {
         let n = names.len();
         let work: Vec<PassWork> = compiled.plan.passes.iter().map(|p| p.work).collect();
         if self.clock == Clock::HostFence {
-            let mut report =
-                self.run_isolated(index, &compiled, &images, &buffers, names, sync)?;
+            let mut report = self.run_isolated(index, &compiled, &images, &buffers, names, sync)?;
             report.set_work(&work);
             self.frame += 1;
             return Ok(previous.or(Some(report)));

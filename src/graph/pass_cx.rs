@@ -218,6 +218,26 @@ impl<'a> PassCx<'a> {
         }
     }
 
+    /// Restricts drawing to a rectangle of the attachment (scissor only).
+    pub fn set_scissor(&self, x: u32, y: u32, width: u32, height: u32) {
+        let scissor = vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x as i32,
+                y: y as i32,
+            },
+            extent: vk::Extent2D { width, height },
+        };
+        unsafe { self.device().cmd_set_scissor(self.cmd, 0, &[scissor]) };
+    }
+
+    /// `count` indices from `first` of the bound index buffer, each plus `vertex_offset`.
+    pub fn draw_indexed_range(&self, count: u32, first: u32, vertex_offset: i32) {
+        unsafe {
+            self.device()
+                .cmd_draw_indexed(self.cmd, count, 1, first, vertex_offset, 0)
+        };
+    }
+
     pub fn draw(&self, vertices: u32, instances: u32) {
         unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
     }
@@ -232,6 +252,36 @@ impl<'a> PassCx<'a> {
         unsafe {
             self.device()
                 .cmd_copy_buffer(self.cmd, self.buffer(src), self.buffer(dst), &[region])
+        };
+    }
+
+    /// Copies level 0 of `src` (TRANSFER_SRC_OPTIMAL) into `dst` (TRANSFER_DST_OPTIMAL):
+    /// same size and format.
+    pub fn copy_image(&self, src: ImageRef, dst: ImageRef) {
+        let (s, d) = (self.image(src), self.image(dst));
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let region = vk::ImageCopy::default()
+            .src_subresource(layers)
+            .dst_subresource(layers)
+            .extent(vk::Extent3D {
+                width: s.desc.width.min(d.desc.width),
+                height: s.desc.height.min(d.desc.height),
+                depth: 1,
+            });
+        unsafe {
+            self.device().cmd_copy_image(
+                self.cmd,
+                s.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                d.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
         };
     }
 

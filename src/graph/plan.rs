@@ -756,7 +756,10 @@ mod tests {
         let plan = g.compile(&mut PoolState::default()).unwrap();
         let first = barriers_for(&plan, 0, 0)[0];
         // Chains with the acquire semaphore's wait at the attachment stage.
-        assert_eq!((first.src_stage, first.src_access), (S::COLOR_ATTACHMENT_OUTPUT, A::NONE));
+        assert_eq!(
+            (first.src_stage, first.src_access),
+            (S::COLOR_ATTACHMENT_OUTPUT, A::NONE)
+        );
         assert_eq!(
             first.layouts,
             Some((L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL))

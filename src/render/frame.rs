@@ -163,6 +163,10 @@ pub(super) struct Frame {
     shade: ShadePass,
     shadow: ShadowPass,
     visibility: VisibilityPass,
+    /// The frame's lights (the scene's, then the extracted sources) and each
+    /// one's shadow projection: the uniforms are made from them.
+    lights: Vec<Light>,
+    views: Vec<Option<ShadowView>>,
     /// The shadowed lights' projections, in atlas tile order.
     shadow_views: Vec<ShadowView>,
     shadow_resolution: u32,
@@ -296,7 +300,9 @@ impl Frame {
             shade: ShadePass::new(ctx, &inputs.variant)?,
             shadow: ShadowPass::new(ctx)?,
             visibility: VisibilityPass::new(ctx, &inputs.variant)?,
-            shadow_views: views.into_iter().flatten().collect(),
+            shadow_views: views.iter().flatten().copied().collect(),
+            views,
+            lights,
             shadow_resolution: scene.file.render.shadow_resolution,
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
@@ -320,6 +326,30 @@ impl Frame {
             gamma: scene.file.render.gamma,
             extracted_lights: extraction.lights.len(),
         })
+    }
+
+    /// Moves the camera to `scene.camera` at the aspect of `scene.file.render`'s
+    /// size: the frame's uniforms are made again; nothing else changes.
+    pub(super) fn set_camera(&mut self, ctx: &Arc<Context>, scene: &Scene) -> Result<()> {
+        let (w, h) = (scene.file.render.width, scene.file.render.height);
+        let uniforms = frame_uniforms(scene, &self.lights, w as f32 / h as f32, &self.views);
+        self.inputs.uniforms = upload_buffer(
+            ctx,
+            "frame uniforms",
+            bytemuck::bytes_of(&uniforms),
+            Access::UniformRead,
+        )?;
+        Ok(())
+    }
+
+    /// A UV-space view's image (stored values) encoded for display, with the
+    /// view's exposure: what `render` does on the CPU for such views.
+    pub(super) fn encode(&self, g: &mut Graph, image: &ImageHandle, view: View) -> ImageHandle {
+        let (w, h) = (image.desc.width, image.desc.height);
+        let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
+        self.tonemap
+            .pass(g, image, &mut ldr, self.exposure_for(view), self.gamma);
+        ldr
     }
 
     /// The occlusion view shows a ratio in [0, 1]: no exposure.

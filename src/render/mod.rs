@@ -6,6 +6,7 @@ mod frame;
 pub mod output;
 mod progress;
 pub mod ruler;
+pub mod session;
 mod view;
 
 pub use view::View;

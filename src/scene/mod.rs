@@ -272,7 +272,7 @@ pub fn load_mesh(file: &SceneFile) -> Result<Mesh> {
 
 /// The scene's camera; with neither a position nor an orbit given, it frames the
 /// mesh from the front (yaw 0, pitch 0).
-fn camera_for(file: &SceneFile, bounds: (Vec3, Vec3)) -> Camera {
+pub fn camera_for(file: &SceneFile, bounds: (Vec3, Vec3)) -> Camera {
     let c = &file.camera;
     let centre = 0.5 * (bounds.0 + bounds.1);
     let mut camera = if c.position.is_none() && c.orbit.is_none() {

@@ -1,0 +1,102 @@
+//! A render that lasts (the viewer's): the scene uploaded and the frame's
+//! pipelines built once, then frames on demand, each encoded for display and
+//! copied into an image of its own that another graph samples. Moving the camera
+//! only makes the frame's uniforms again; anything else is a new session.
+
+use super::frame::Frame;
+use super::{check_target, View};
+use crate::error::Result;
+use crate::gpu::{Context, Image, ImageDesc};
+use crate::graph::{Access, Executor, Graph, Imported};
+use crate::profile::FrameReport;
+use crate::scene::camera::Camera;
+use crate::scene::Scene;
+use crate::skin::SkinSettings;
+use ash::vk;
+use std::sync::Arc;
+
+pub struct Session {
+    ctx: Arc<Context>,
+    scene: Scene,
+    frame: Frame,
+    executor: Executor,
+    /// The next frame is the session's first (it also computes what is kept:
+    /// stretch maps, SH, the prefiltered environment).
+    first: bool,
+}
+
+impl Session {
+    pub fn new(ctx: &Arc<Context>, scene: Scene) -> Result<Self> {
+        let render = &scene.file.render;
+        check_target(&ctx.info, render.width, render.height)?;
+        let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
+        check_target(&ctx.info, skin.resolution, skin.resolution)?;
+        let frame = Frame::new(ctx, &scene, skin, false)?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            executor: Executor::new(ctx, 1)?,
+            scene,
+            frame,
+            first: true,
+        })
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Bright sources the session's frames light with (`environment.lights`).
+    pub fn extracted_lights(&self) -> usize {
+        self.frame.extracted_lights
+    }
+
+    /// Moves the camera and sets the frame's size (its aspect): uniforms only.
+    pub fn set_camera(&mut self, camera: Camera, (width, height): (u32, u32)) -> Result<()> {
+        check_target(&self.ctx.info, width, height)?;
+        self.scene.camera = camera;
+        self.scene.file.render.width = width;
+        self.scene.file.render.height = height;
+        self.frame.set_camera(&self.ctx, &self.scene)
+    }
+
+    /// Renders `view` once and waits for it: the displayable image (RGBA8,
+    /// sRGB-encoded, left in SHADER_READ_ONLY_OPTIMAL for fragment sampling)
+    /// and the frame's report.
+    pub fn render(&mut self, view: View) -> Result<(Arc<Image>, Option<FrameReport>)> {
+        let size = (self.scene.file.render.width, self.scene.file.render.height);
+        let mut g = Graph::new();
+        let (hdr, ldr) = self.frame.graph(&mut g, view, size, self.first);
+        let ldr = match ldr {
+            Some(ldr) => ldr,
+            None => self.frame.encode(&mut g, &hdr, view),
+        };
+        let (w, h) = (ldr.desc.width, ldr.desc.height);
+        let image = Arc::new(Image::new(
+            &self.ctx,
+            "viewer frame",
+            ImageDesc::new(w, h, ldr.desc.format),
+            vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED,
+        )?);
+        let mut out = g.import_image(
+            "viewer frame",
+            Imported::Image(image.clone()),
+            None,
+            Some(Access::FragmentSampled),
+        );
+        let mut p = g.add_pass("to viewer");
+        let (src, dst) = (
+            p.read(&ldr, Access::TransferSrc),
+            p.write(&mut out, Access::TransferDst),
+        );
+        p.record(move |cx| cx.copy_image(src, dst));
+        let compiled = self.executor.compile(g)?;
+        let mut reports = self
+            .executor
+            .submit(compiled)?
+            .into_iter()
+            .collect::<Vec<_>>();
+        reports.extend(self.executor.finish()?);
+        self.first = false;
+        Ok((image, reports.pop()))
+    }
+}

@@ -1,0 +1,264 @@
+//! The viewer's controls (the paper's menus, Figs. 4–5) in an egui side panel and
+//! the same in a right-click menu over the image, the live per-pass timings and
+//! the frame-time graph. The controls edit a scene file and a view; the window
+//! renders again when they change.
+
+use super::camera::Orbit;
+use crate::profile::FrameReport;
+use crate::render::View;
+use crate::scene::env::EnvSource;
+use crate::scene::file::{Chain, Kernel, LightsMode, Occlusion, SceneFile};
+use std::collections::VecDeque;
+
+/// Frames the timings are the median of, and the graph shows.
+pub const HISTORY: usize = 120;
+
+/// What the controls edit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Controls {
+    pub file: SceneFile,
+    pub view: View,
+    pub orbit: Orbit,
+}
+
+/// Environments offered besides the scene's own: the CC0 maps shipped in
+/// `assets/env` (where they are), the built-in sky and a uniform grey.
+pub fn environments(scene_env: &EnvSource) -> Vec<(String, EnvSource)> {
+    let mut out = vec![("scene's".to_string(), scene_env.clone())];
+    for name in crate::assets::ENV_MAPS {
+        let path = crate::assets::path(&format!("env/{name}"));
+        if path.is_file() {
+            out.push((name.to_string(), EnvSource::File(path)));
+        }
+    }
+    for s in ["sky", "uniform:0.5,0.5,0.5"] {
+        if let Ok(source) = s.parse() {
+            out.push((s.to_string(), source));
+        }
+    }
+    out
+}
+
+/// Per-pass history of the rendered frames and the window's frame times.
+#[derive(Default)]
+pub struct Timings {
+    /// Rendered frames (the skin pipeline).
+    frames: VecDeque<FrameReport>,
+    /// Window frames (present, ui).
+    window: VecDeque<FrameReport>,
+    window_ms: VecDeque<f64>,
+}
+
+impl Timings {
+    pub fn add_frame(&mut self, report: FrameReport) {
+        push(&mut self.frames, report);
+    }
+
+    pub fn add_window_frame(&mut self, report: FrameReport) {
+        push(&mut self.window, report);
+    }
+
+    pub fn add_window_ms(&mut self, ms: f64) {
+        push(&mut self.window_ms, ms);
+    }
+
+    /// (pass, median ms, frames) over the rendered frames kept, then the
+    /// window's, in pass order.
+    pub fn passes(&self) -> Vec<(String, f64, usize)> {
+        [&self.frames, &self.window]
+            .into_iter()
+            .flat_map(|frames| {
+                let mut names: Vec<&str> = Vec::new();
+                for p in frames.iter().flat_map(|f| &f.passes) {
+                    if !names.contains(&p.name.as_str()) {
+                        names.push(&p.name);
+                    }
+                }
+                names.into_iter().map(|n| {
+                    let mut v: Vec<f64> = frames.iter().filter_map(|f| f.pass_ns(n)).collect();
+                    v.sort_by(f64::total_cmp);
+                    (n.to_string(), v[v.len() / 2] / 1e6, v.len())
+                })
+            })
+            .collect()
+    }
+}
+
+fn push<T>(q: &mut VecDeque<T>, v: T) {
+    if q.len() == HISTORY {
+        q.pop_front();
+    }
+    q.push_back(v);
+}
+
+/// What the window shows beside the controls.
+pub struct Status<'a> {
+    pub device: &'a str,
+    /// The last render: its size, sources extracted, seconds; or an error.
+    pub last: &'a str,
+    pub rendering: bool,
+}
+
+/// The side panel and the right-click menu over the rest; returns whether a
+/// screenshot was asked for.
+pub fn show(
+    ui: &mut egui::Ui,
+    c: &mut Controls,
+    envs: &[(String, EnvSource)],
+    status: &Status,
+    timings: &Timings,
+) -> bool {
+    let mut screenshot = false;
+    egui::Panel::left("controls")
+        .default_size(270.0)
+        .show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.heading("dermis");
+                ui.label(status.device);
+                ui.label(if status.rendering {
+                    "rendering…"
+                } else {
+                    status.last
+                });
+                ui.separator();
+                controls(ui, c, envs);
+                ui.separator();
+                screenshot = ui.button("Screenshot (F12)").clicked();
+                egui::CollapsingHeader::new("Timings")
+                    .default_open(true)
+                    .show(ui, |ui| timing_table(ui, timings));
+                egui::CollapsingHeader::new("Keys").show(ui, |ui| {
+                    ui.label(HELP);
+                });
+            });
+        });
+    let response = egui::CentralPanel::no_frame()
+        .show(ui, |ui| {
+            ui.allocate_rect(ui.max_rect(), egui::Sense::click())
+        })
+        .inner;
+    response.context_menu(|ui| controls(ui, c, envs));
+    screenshot
+}
+
+/// The keys and the mouse, as the window's help lists them.
+pub const HELP: &str = "Left drag: orbit\nRight or middle drag: pan\nWheel: zoom\n\
+Shift + left drag: turn the environment\nRight click: the controls\n\
+F12: screenshot (PNG)\nR: reload the scene file\nEsc: quit";
+
+/// The paper's menu: view, exposure, lighting, diffusion.
+fn controls(ui: &mut egui::Ui, c: &mut Controls, envs: &[(String, EnvSource)]) {
+    let f = &mut c.file;
+    egui::ComboBox::from_label("view")
+        .selected_text(c.view.name())
+        .show_ui(ui, |ui| {
+            for v in View::ALL.into_iter().filter(|v| *v != View::Reference) {
+                ui.selectable_value(&mut c.view, v, v.name());
+            }
+        });
+    let mut metered = f.render.exposure.is_none();
+    ui.checkbox(&mut metered, "metered exposure");
+    if metered {
+        f.render.exposure = None;
+    } else {
+        let mut ev = f.render.exposure.unwrap_or(0.0);
+        ui.add(egui::Slider::new(&mut ev, -8.0..=8.0).text("exposure (EV)"));
+        f.render.exposure = Some(ev);
+    }
+    ui.checkbox(&mut f.render.skybox, "skybox");
+    ui.separator();
+    let current = envs
+        .iter()
+        .find(|(_, s)| *s == f.environment.source)
+        .map_or_else(|| f.environment.source.to_string(), |(n, _)| n.clone());
+    egui::ComboBox::from_label("environment")
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            for (name, source) in envs {
+                ui.selectable_value(&mut f.environment.source, source.clone(), name);
+            }
+        });
+    ui.add(egui::Slider::new(&mut f.environment.rotation_deg, 0.0..=360.0).text("rotation (°)"));
+    let mut lights = f.environment.lights != LightsMode::Count(0);
+    ui.checkbox(&mut lights, "bright sources as lights");
+    f.environment.lights = if lights {
+        LightsMode::Auto
+    } else {
+        LightsMode::Count(0)
+    };
+    egui::ComboBox::from_label("occlusion")
+        .selected_text(format!("{:?}", f.skin.occlusion).to_lowercase())
+        .show_ui(ui, |ui| {
+            for o in [Occlusion::Raytrace, Occlusion::Raster, Occlusion::Off] {
+                ui.selectable_value(&mut f.skin.occlusion, o, format!("{o:?}").to_lowercase());
+            }
+        });
+    ui.separator();
+    egui::ComboBox::from_label("irradiance")
+        .selected_text(format!("{}²", f.render.irradiance_resolution))
+        .show_ui(ui, |ui| {
+            for r in [256, 512, 1024, 2048, 4096] {
+                ui.selectable_value(&mut f.render.irradiance_resolution, r, format!("{r}²"));
+            }
+        });
+    egui::ComboBox::from_label("kernel")
+        .selected_text(format!("{:?}", f.skin.kernel).to_lowercase())
+        .show_ui(ui, |ui| {
+            for k in [Kernel::Deon7, Kernel::Accurate] {
+                ui.selectable_value(&mut f.skin.kernel, k, format!("{k:?}").to_lowercase());
+            }
+        });
+    egui::ComboBox::from_label("chain")
+        .selected_text(format!("{:?}", f.skin.chain).to_lowercase())
+        .show_ui(ui, |ui| {
+            for ch in [Chain::Adaptive, Chain::Full] {
+                ui.selectable_value(&mut f.skin.chain, ch, format!("{ch:?}").to_lowercase());
+            }
+        });
+}
+
+/// Per-pass medians of the rendered frames kept, and the window's frame times.
+fn timing_table(ui: &mut egui::Ui, t: &Timings) {
+    let passes = t.passes();
+    ui.label(format!(
+        "medians of the last {} rendered and {} window frames",
+        t.frames.len(),
+        t.window.len()
+    ));
+    egui::Grid::new("passes").striped(true).show(ui, |ui| {
+        for (name, ms, _) in &passes {
+            ui.label(name);
+            ui.label(format!("{ms:.2} ms"));
+            ui.end_row();
+        }
+    });
+    ui.label("window frames (ms):");
+    let (rect, _) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 60.0), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    let max = t.window_ms.iter().copied().fold(1.0, f64::max);
+    let points: Vec<egui::Pos2> = t
+        .window_ms
+        .iter()
+        .enumerate()
+        .map(|(i, ms)| {
+            egui::pos2(
+                rect.left() + rect.width() * i as f32 / HISTORY as f32,
+                rect.bottom() - rect.height() * (*ms / max) as f32,
+            )
+        })
+        .collect();
+    painter.rect_stroke(
+        rect,
+        0.0,
+        ui.visuals().widgets.noninteractive.bg_stroke,
+        egui::StrokeKind::Inside,
+    );
+    painter.add(egui::Shape::line(
+        points,
+        ui.visuals().widgets.active.fg_stroke,
+    ));
+    if let Some(last) = t.window_ms.back() {
+        ui.label(format!("last {last:.1} ms, max {max:.1} ms"));
+    }
+}
