@@ -163,8 +163,9 @@ impl App {
             .handle_platform_output(&open.window, output.platform_output);
         let primitives = self.egui.tessellate(output.shapes, output.pixels_per_point);
         let size = open.window.inner_size();
-        let size = (size.width.max(1), size.height.max(1));
-        if self.sent.as_ref() != Some(&(self.controls.clone(), size)) {
+        let size = (size.width, size.height);
+        let minimised = size.0 == 0 || size.1 == 0;
+        if !minimised && self.sent.as_ref() != Some(&(self.controls.clone(), size)) {
             open.worker.send(Job {
                 file: self.controls.file.clone(),
                 view: self.controls.view,

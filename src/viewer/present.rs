@@ -107,6 +107,11 @@ impl Presenter {
         screenshot: Option<&Path>,
     ) -> Result<Option<Presented>> {
         self.egui.update_textures(textures)?;
+        if screenshot.is_some() && !image_usage_copies(&self.swapchain) {
+            return Err(Error::Window(
+                "this window's surface does not let its images be copied: no screenshot".into(),
+            ));
+        }
         if self.size.0 == 0 || self.size.1 == 0 {
             return Ok(None);
         }
@@ -176,6 +181,14 @@ impl Presenter {
     pub fn finish(&mut self) -> Result<Vec<FrameReport>> {
         self.executor.finish()
     }
+}
+
+/// Whether the swapchain's images can be copied out (screenshots).
+fn image_usage_copies(swapchain: &Swapchain) -> bool {
+    swapchain
+        .images
+        .first()
+        .is_some_and(|i| i.usage.contains(vk::ImageUsageFlags::TRANSFER_SRC))
 }
 
 /// `frame` imported for sampling: the render thread left it in
