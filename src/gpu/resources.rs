@@ -117,16 +117,22 @@ impl Image {
         unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
         image.allocation = Some(allocation);
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(desc.format)
-            .subresource_range(full_range(desc.format, desc.mip_levels));
-        image.view =
-            unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        image.create_view(name)?;
         ctx.name(raw, name);
-        ctx.name(image.view, name);
         Ok(image)
+    }
+
+    /// The view of every level, named `name`.
+    fn create_view(&mut self, name: &str) -> Result<()> {
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(self.raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(self.desc.format)
+            .subresource_range(full_range(self.desc.format, self.desc.mip_levels));
+        self.view = unsafe { self.ctx.device.create_image_view(&view_info, None) }
+            .vk("vkCreateImageView")?;
+        self.ctx.name(self.view, name);
+        Ok(())
     }
 
     /// An image another object owns (a swapchain's), with a view of our own so
@@ -147,14 +153,7 @@ impl Image {
             allocation: None,
             external: true,
         };
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(desc.format)
-            .subresource_range(full_range(desc.format, desc.mip_levels));
-        image.view =
-            unsafe { ctx.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
-        ctx.name(image.view, name);
+        image.create_view(name)?;
         Ok(image)
     }
 }

@@ -26,22 +26,34 @@ pub fn coverage_mask(rgba: &[f32]) -> Vec<bool> {
     rgba.chunks_exact(4).map(|p| p[3] > 0.5).collect()
 }
 
-/// `image` against `reference` (both RGBA f32 of the same size) over `mask`.
-pub fn compare(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<ImageError> {
+/// The (reference, image) RGBA pixels `mask` keeps; `what` names the metric in
+/// the error for images of different sizes.
+fn masked<'a>(
+    what: &str,
+    reference: &'a [f32],
+    image: &'a [f32],
+    mask: &'a [bool],
+) -> Result<impl Iterator<Item = (&'a [f32], &'a [f32])>> {
     if reference.len() != image.len() || reference.len() != 4 * mask.len() {
         return Err(Error::Input(format!(
-            "image error: sizes differ ({} and {} values, mask of {} pixels)",
+            "{what}: sizes differ ({} and {} values, mask of {} pixels)",
             reference.len(),
             image.len(),
             mask.len()
         )));
     }
-    let pairs: Vec<(f64, f64)> = reference
+    Ok(reference
         .chunks_exact(4)
         .zip(image.chunks_exact(4))
         .zip(mask)
         .filter(|(_, &m)| m)
-        .flat_map(|((r, a), _)| (0..3).map(move |c| (r[c] as f64, a[c] as f64)))
+        .map(|(pair, _)| pair))
+}
+
+/// `image` against `reference` (both RGBA f32 of the same size) over `mask`.
+pub fn compare(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<ImageError> {
+    let pairs: Vec<(f64, f64)> = masked("image error", reference, image, mask)?
+        .flat_map(|(r, a)| (0..3).map(move |c| (r[c] as f64, a[c] as f64)))
         .collect();
     let pixels = pairs.len() / 3;
     let mean = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.len().max(1) as f64;
@@ -90,20 +102,8 @@ fn luminance(p: &[f32]) -> f64 {
 
 /// [`RelativeError`] of `image` against `reference` (RGBA f32, same size) over `mask`.
 pub fn relative(reference: &[f32], image: &[f32], mask: &[bool]) -> Result<RelativeError> {
-    if reference.len() != image.len() || reference.len() != 4 * mask.len() {
-        return Err(Error::Input(format!(
-            "relative error: sizes differ ({} and {} values, mask of {} pixels)",
-            reference.len(),
-            image.len(),
-            mask.len()
-        )));
-    }
-    let pairs: Vec<(f64, f64)> = reference
-        .chunks_exact(4)
-        .zip(image.chunks_exact(4))
-        .zip(mask)
-        .filter(|(_, &m)| m)
-        .map(|((r, a), _)| (luminance(r), luminance(a)))
+    let pairs: Vec<(f64, f64)> = masked("relative error", reference, image, mask)?
+        .map(|(r, a)| (luminance(r), luminance(a)))
         .collect();
     let mean = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.len().max(1) as f64;
     if pairs.is_empty() || mean <= 0.0 || !mean.is_finite() {

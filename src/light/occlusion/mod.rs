@@ -23,7 +23,7 @@ mod cache;
 pub mod raster;
 mod raytrace;
 #[cfg(test)]
-mod testutil;
+pub(crate) mod testutil;
 mod transfer;
 
 pub use bvh::{Bvh, Hit};

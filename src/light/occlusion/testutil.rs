@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::scene::mesh::Mesh;
 
 /// Mesh from positions, normals and triangles (other attributes filled).
-pub(super) fn mesh(positions: Vec<Vec3>, normals: Vec<Vec3>, indices: Vec<u32>) -> Mesh {
+pub(crate) fn mesh(positions: Vec<Vec3>, normals: Vec<Vec3>, indices: Vec<u32>) -> Mesh {
     let n = positions.len();
     Mesh {
         name: "test".into(),

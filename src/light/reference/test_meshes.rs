@@ -4,20 +4,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::light::occlusion::testutil::mesh;
 use crate::scene::mesh::Mesh;
-
-/// Mesh from positions, normals and triangles (other attributes filled).
-fn mesh(positions: Vec<Vec3>, normals: Vec<Vec3>, indices: Vec<u32>) -> Mesh {
-    let n = positions.len();
-    Mesh {
-        name: "test".into(),
-        positions,
-        normals,
-        uvs: vec![Vec2::ZERO; n],
-        tangents: vec![Vec4::X; n],
-        indices,
-    }
-}
 
 /// Square of half-size `h` in y = 0 about the origin, normal +Y.
 pub fn plane(h: f32) -> Mesh {
