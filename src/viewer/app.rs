@@ -63,6 +63,8 @@ impl App {
                 file: opts.scene.clone(),
                 view: crate::render::View::Final,
                 orbit,
+                env_text: String::new(),
+                env_error: None,
             },
             opts,
             open: None,

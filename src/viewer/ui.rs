@@ -19,6 +19,10 @@ pub struct Controls {
     pub file: SceneFile,
     pub view: View,
     pub orbit: Orbit,
+    /// The environment field: a source typed in (a file, `sky:…`, `uniform:…`).
+    pub env_text: String,
+    /// Why the last one typed was refused.
+    pub env_error: Option<String>,
 }
 
 /// Environments offered besides the scene's own: the CC0 maps shipped in
@@ -178,6 +182,22 @@ fn controls(ui: &mut egui::Ui, c: &mut Controls, envs: &[(String, EnvSource)]) {
                 ui.selectable_value(&mut f.environment.source, source.clone(), name);
             }
         });
+    ui.horizontal(|ui| {
+        ui.text_edit_singleline(&mut c.env_text)
+            .on_hover_text("a .hdr/.exr file, sky[:…] or uniform:R,G,B");
+        if ui.button("load").clicked() {
+            match c.env_text.parse::<EnvSource>() {
+                Ok(source) => {
+                    f.environment.source = source;
+                    c.env_error = None;
+                }
+                Err(e) => c.env_error = Some(e.to_string()),
+            }
+        }
+    });
+    if let Some(e) = &c.env_error {
+        ui.colored_label(ui.visuals().error_fg_color, e);
+    }
     ui.add(egui::Slider::new(&mut f.environment.rotation_deg, 0.0..=360.0).text("rotation (°)"));
     let mut lights = f.environment.lights != LightsMode::Count(0);
     ui.checkbox(&mut lights, "bright sources as lights");
