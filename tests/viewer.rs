@@ -1,5 +1,5 @@
 //! `dermis view` in a real window: an X server (Xvfb) is started for the test,
-//! the viewer renders 24 window frames of the scan with validation and
+//! the viewer renders 24 window frames of the scan at 960 × 640 with validation and
 //! synchronization validation on, resizes its window halfway (the swapchain is
 //! made again), and writes its last frame; the screenshot must show the face
 //! and the layer must have said nothing. Without Xvfb the test fails, saying so:
@@ -59,7 +59,7 @@ fn the_viewer_shows_the_face_in_a_window_and_survives_a_resize() {
     let shot = dir.join("view.png");
     let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
         .args(["--validation", "view", "--irradiance-res", "256"])
-        .args(["--width", "640", "--height", "480", "--frames", "24"])
+        .args(["--width", "960", "--height", "640", "--frames", "24"])
         .arg("--screenshot")
         .arg(&shot)
         .env("DISPLAY", &x.display)
@@ -74,13 +74,13 @@ fn the_viewer_shows_the_face_in_a_window_and_survives_a_resize() {
         "validation reported:\n{stderr}"
     );
     let img = image::open(&shot).expect("the screenshot").to_rgba8();
-    // Resized halfway: 640×480 → 480×360.
-    assert_eq!(img.dimensions(), (480, 360), "the window was not resized");
-    // Right of the control panel (270 points wide) the face fills the middle:
-    // skin is red over blue, and the region is not one colour.
+    // Resized halfway: 960×640 → 720×480.
+    assert_eq!(img.dimensions(), (720, 480), "the window was not resized");
+    // Beside the control panel (on the left) the face fills the middle of the
+    // rest: skin is red over blue, and the region is not one colour.
     let (w, h) = img.dimensions();
     let region: Vec<[f32; 3]> = (h / 4..3 * h / 4)
-        .flat_map(|y| (300..w - 20).map(move |x| (x, y)))
+        .flat_map(|y| (w * 6 / 10..w * 9 / 10).map(move |x| (x, y)))
         .map(|(x, y)| {
             let p = img.get_pixel(x, y);
             [p[0] as f32, p[1] as f32, p[2] as f32]

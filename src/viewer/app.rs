@@ -157,15 +157,23 @@ impl App {
             rendering: !open.worker.idle(),
         };
         let (controls, envs, timings) = (&mut self.controls, &self.envs, &self.timings);
-        let mut shot = false;
+        let (mut shot, mut area) = (false, egui::Rect::NOTHING);
         let output = self.egui.run_ui(input, |ui| {
-            shot |= ui::show(ui, controls, envs, &status, timings);
+            let (s, a) = ui::show(ui, controls, envs, &status, timings);
+            (shot, area) = (shot || s, a);
         });
         open.egui_state
             .handle_platform_output(&open.window, output.platform_output);
         let primitives = self.egui.tessellate(output.shapes, output.pixels_per_point);
-        let size = open.window.inner_size();
-        let size = (size.width, size.height);
+        // The frame fills the area beside the panel, in pixels.
+        let area = area * output.pixels_per_point;
+        let rect = [
+            area.min.x,
+            area.min.y,
+            area.width().max(0.0),
+            area.height().max(0.0),
+        ];
+        let size = (rect[2].round() as u32, rect[3].round() as u32);
         let minimised = size.0 == 0 || size.1 == 0;
         if !minimised && self.sent.as_ref() != Some(&(self.controls.clone(), size)) {
             open.worker.send(Job {
@@ -185,9 +193,11 @@ impl App {
         if let Some(n) = headless {
             if !self.resized && self.frames >= n / 2 {
                 self.resized = true;
-                let _ = open
-                    .window
-                    .request_inner_size(PhysicalSize::new(size.0 * 3 / 4, size.1 * 3 / 4));
+                let window = open.window.inner_size();
+                let _ = open.window.request_inner_size(PhysicalSize::new(
+                    window.width * 3 / 4,
+                    window.height * 3 / 4,
+                ));
             }
         }
         let last_frame = headless.is_some_and(|n| {
@@ -198,6 +208,7 @@ impl App {
         }
         let presented = open.presenter.frame(
             open.shown.as_ref(),
+            rect,
             &primitives,
             &output.textures_delta,
             output.pixels_per_point,
@@ -305,6 +316,10 @@ impl App {
     /// Tears down in order: the render thread, the frames in flight and the
     /// swapchain, the window, then the device.
     fn close(&mut self) -> Result<()> {
+        for (pass, ms, frames) in self.timings.passes() {
+            log::info!("{pass}: median {ms:.2} ms over {frames} frame(s)");
+        }
+        log::info!("{}", self.timings.window_summary());
         if let Some(mut open) = self.open.take() {
             drop(open.worker);
             open.presenter.finish()?;

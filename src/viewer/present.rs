@@ -94,13 +94,15 @@ impl Presenter {
     }
 
     /// Draws `frame` (the latest rendered image; `None` before the first),
-    /// letterboxed, then egui's `primitives` after applying `textures`, and
+    /// letterboxed into `area` (x, y, width, height in pixels), then egui's
+    /// `primitives` after applying `textures`, and
     /// presents. With `screenshot`, waits for the frame and writes the window's
     /// image there as PNG. `None` when there was nothing to draw into (a
     /// minimised window, or a swapchain that had to be recreated first).
     pub fn frame(
         &mut self,
         frame: Option<&Arc<Image>>,
+        area: [f32; 4],
         primitives: &[ClippedPrimitive],
         textures: &egui::TexturesDelta,
         pixels_per_point: f32,
@@ -139,7 +141,7 @@ impl Presenter {
             Some(Access::Acquired),
             Some(Access::Present),
         );
-        let rect = letterbox(frame.map(|f| (f.desc.width, f.desc.height)), (w, h));
+        let rect = letterbox(frame.map(|f| (f.desc.width, f.desc.height)), area);
         let shown = frame.map(|f| pass_import(&mut g, f));
         let pass = g.simple_pass("present", &self.present);
         let pass = match &shown {
@@ -202,13 +204,12 @@ fn pass_import(g: &mut Graph, frame: &Arc<Image>) -> crate::graph::ImageHandle {
     )
 }
 
-/// The largest rectangle of `frame`'s aspect centred in `window` (x, y, w, h).
-fn letterbox(frame: Option<(u32, u32)>, (ww, wh): (u32, u32)) -> [f32; 4] {
-    let (ww, wh) = (ww as f32, wh as f32);
-    let (fw, fh) = frame.map_or((ww, wh), |(w, h)| (w as f32, h as f32));
-    let scale = (ww / fw).min(wh / fh);
+/// The largest rectangle of `frame`'s aspect centred in `area` (x, y, w, h).
+fn letterbox(frame: Option<(u32, u32)>, [x, y, aw, ah]: [f32; 4]) -> [f32; 4] {
+    let (fw, fh) = frame.map_or((aw, ah), |(w, h)| (w as f32, h as f32));
+    let scale = (aw / fw).min(ah / fh);
     let (w, h) = (fw * scale, fh * scale);
-    [(ww - w) / 2.0, (wh - h) / 2.0, w, h]
+    [x + (aw - w) / 2.0, y + (ah - h) / 2.0, w, h]
 }
 
 /// Writes a swapchain image read back as `format` (BGRA or RGBA) as a PNG.
@@ -229,17 +230,20 @@ mod tests {
 
     #[test]
     fn frames_are_letterboxed_at_their_aspect() {
-        // A portrait frame in a landscape window: bars left and right.
+        // A portrait frame in a landscape area: bars left and right.
         assert_eq!(
-            letterbox(Some((768, 960)), (1200, 600)),
+            letterbox(Some((768, 960)), [0.0, 0.0, 1200.0, 600.0]),
             [360.0, 0.0, 480.0, 600.0]
         );
-        // A landscape frame in a portrait window: bars top and bottom.
+        // A landscape frame in a portrait area beside a 100-pixel panel.
         assert_eq!(
-            letterbox(Some((200, 100)), (400, 400)),
-            [0.0, 100.0, 400.0, 200.0]
+            letterbox(Some((200, 100)), [100.0, 0.0, 400.0, 400.0]),
+            [100.0, 100.0, 400.0, 200.0]
         );
-        // No frame: the whole window.
-        assert_eq!(letterbox(None, (640, 480)), [0.0, 0.0, 640.0, 480.0]);
+        // No frame: the whole area.
+        assert_eq!(
+            letterbox(None, [0.0, 0.0, 640.0, 480.0]),
+            [0.0, 0.0, 640.0, 480.0]
+        );
     }
 }

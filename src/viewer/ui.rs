@@ -88,6 +88,21 @@ impl Timings {
     }
 }
 
+impl Timings {
+    /// The window frames' median and worst time, ms.
+    pub fn window_summary(&self) -> String {
+        let mut v: Vec<f64> = self.window_ms.iter().copied().collect();
+        v.sort_by(f64::total_cmp);
+        match (v.get(v.len() / 2), v.last()) {
+            (Some(median), Some(max)) => format!(
+                "window frames: median {median:.1} ms, max {max:.1} ms over {}",
+                v.len()
+            ),
+            _ => "window frames: none".into(),
+        }
+    }
+}
+
 fn push<T>(q: &mut VecDeque<T>, v: T) {
     if q.len() == HISTORY {
         q.pop_front();
@@ -104,14 +119,15 @@ pub struct Status<'a> {
 }
 
 /// The side panel and the right-click menu over the rest; returns whether a
-/// screenshot was asked for.
+/// screenshot was asked for and the rest's rectangle (points), where the
+/// rendered frame goes.
 pub fn show(
     ui: &mut egui::Ui,
     c: &mut Controls,
     envs: &[(String, EnvSource)],
     status: &Status,
     timings: &Timings,
-) -> bool {
+) -> (bool, egui::Rect) {
     let mut screenshot = false;
     egui::Panel::left("controls")
         .default_size(270.0)
@@ -142,7 +158,7 @@ pub fn show(
         })
         .inner;
     response.context_menu(|ui| controls(ui, c, envs));
-    screenshot
+    (screenshot, response.rect)
 }
 
 /// The keys and the mouse, as the window's help lists them.
