@@ -15,5 +15,6 @@ pub mod scene;
 pub mod skin;
 pub mod sweep;
 pub mod testscene;
+pub mod text;
 
 pub use error::{Error, Result};
