@@ -15,8 +15,8 @@ use std::sync::Arc;
 /// What the pass draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DebugView {
-    /// Distance along the view axis, 1 (white) at the front of the mesh's
-    /// bounding sphere to 0 at its back: `(far − z) / (far − near)`.
+    /// Distance z along the view axis, 1 (white) at the mesh's nearest vertex
+    /// to 0 at its farthest: `(far − z) / (far − near)`.
     Depth = 0,
     /// The shading normal after the normal map, world space, 0.5·n + 0.5.
     Normals = 1,
@@ -36,8 +36,8 @@ struct DebugPush {
     mode: u32,
 }
 
-/// Where the depth view's 1 and 0 lie: the mesh's bounding sphere along the
-/// camera's viewing direction.
+/// Where the depth view's 1 and 0 lie: the mesh's nearest and farthest vertex
+/// along the camera's viewing direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DepthRange {
     pub forward: Vec3,
@@ -46,14 +46,15 @@ pub struct DepthRange {
 }
 
 impl DepthRange {
-    /// For a camera at `eye` looking along `forward` (unit) at a mesh inside
-    /// the sphere (`centre`, `radius`).
-    pub fn of(eye: Vec3, forward: Vec3, centre: Vec3, radius: f32) -> DepthRange {
-        let z = forward.dot(centre - eye);
+    /// For a camera at `eye` looking along `forward` (unit) at the mesh's
+    /// `positions` (mm).
+    pub fn of(eye: Vec3, forward: Vec3, positions: &[Vec3]) -> DepthRange {
+        let z = positions.iter().map(|&p| forward.dot(p - eye));
+        let (near_mm, far_mm) = z.fold((f32::MAX, f32::MIN), |(lo, hi), z| (lo.min(z), hi.max(z)));
         DepthRange {
             forward,
-            near_mm: z - radius,
-            far_mm: z + radius,
+            near_mm,
+            far_mm: far_mm.max(near_mm + 1e-3),
         }
     }
 }

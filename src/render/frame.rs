@@ -298,13 +298,11 @@ impl Frame {
             skin.chain,
             levels
         );
-        let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
         let camera = &scene.camera;
         let depth_range = DepthRange::of(
             camera.position,
             (camera.target - camera.position).normalize_or_zero(),
-            0.5 * (lo + hi),
-            0.5 * lo.distance(hi),
+            &scene.mesh.positions,
         );
         Ok(Self {
             tables,

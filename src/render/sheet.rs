@@ -49,16 +49,12 @@ pub fn compose(tiles: &[(String, RenderOutput)], columns: usize, tile: (u32, u32
                 rgba8[i..i + 4].copy_from_slice(&p);
             }
         }
-        let text_x = x0 as f32 + 0.5 * (cell_w as f32 - crate::text::width(label, LABEL_PX));
-        let text_y = (y0 + tile.1) as f32 + 0.5 * (LABEL as f32 - LABEL_PX);
-        crate::text::draw(
-            &mut rgba8,
-            width,
-            (text_x.max(x0 as f32), text_y),
-            LABEL_PX,
-            INK,
-            label,
-        );
+        // Smaller type where the label would not fit the tile.
+        let fits = (cell_w as f32 - 4.0) / crate::text::width(label, LABEL_PX);
+        let px = LABEL_PX * fits.min(1.0);
+        let text_x = x0 as f32 + 0.5 * (cell_w as f32 - crate::text::width(label, px));
+        let text_y = (y0 + tile.1) as f32 + 0.5 * (LABEL as f32 - px);
+        crate::text::draw(&mut rgba8, width, (text_x, text_y), px, INK, label);
     }
     Sheet {
         width,
