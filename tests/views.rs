@@ -100,7 +100,11 @@ fn the_debug_sheet_and_the_occlusion_comparison_are_labelled_images_of_their_vie
             .collect()
     };
     let (on, off) = (half(true), half(false));
-    let differ = on.chunks_exact(4).zip(off.chunks_exact(4)).filter(|(a, b)| a != b).count();
+    let differ = on
+        .chunks_exact(4)
+        .zip(off.chunks_exact(4))
+        .filter(|(a, b)| a != b)
+        .count();
     println!(
         "sheet {}×{}, comparison {}×{}: {differ} pixels differ",
         sheet.width, sheet.height, comparison.width, comparison.height
@@ -111,5 +115,8 @@ fn the_debug_sheet_and_the_occlusion_comparison_are_labelled_images_of_their_vie
         let start = ((y * sheet.width) * 4) as usize;
         sheet.rgba8[start..start + (TILE.0 * 4) as usize].to_vec()
     });
-    assert!(strip.collect::<Vec<u8>>().chunks_exact(4).any(|p| p[0] > 200));
+    assert!(strip
+        .collect::<Vec<u8>>()
+        .chunks_exact(4)
+        .any(|p| p[0] > 200));
 }
