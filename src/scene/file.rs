@@ -1088,6 +1088,8 @@ shadow = false
 mix = 0.25
 kernel = "accurate"
 occlusion = "off"
+blur_width = 0.5
+blur_amount = 0.75
 profile = [
   { variance_mm2 = 0.01, weights = [0.5, 0.5, 0.5] },
   { variance_mm2 = 1.0, weights = [0.5, 0.5, 0.5] },
@@ -1099,6 +1101,11 @@ height = 480
 irradiance_resolution = 1024
 exposure = -1.5
 gamma = 2.2
+tone_curve = "neutral"
+skybox = false
+background = [0.1, 0.2, 0.3]
+glow = true
+glow_intensity = 0.5
 "#;
         let s = parse(text).unwrap();
         assert_eq!(s.mesh, Some(PathBuf::from("/scenes/meshes/head.glb")));
@@ -1127,6 +1134,12 @@ gamma = 2.2
         assert_eq!(s.skin.profile.as_ref().map(Vec::len), Some(2));
         assert_eq!(s.render.gamma, Gamma::Power(2.2));
         assert_eq!(s.render.exposure, Some(-1.5));
+        assert_eq!(s.render.tone_curve, ToneCurve::Neutral);
+        assert!(!s.render.skybox && s.render.glow);
+        assert_eq!(s.render.background, [0.1, 0.2, 0.3]);
+        assert_eq!(s.render.glow_intensity, 0.5);
+        assert_eq!((s.skin.blur_width, s.skin.blur_amount), (0.5, 0.75));
+        assert!(!s.textures.test_texture);
 
         // Orbit: yaw 30, pitch 10, 600 mm from the centre.
         let centre = Vec3::new(1.0, 2.0, 3.0);
@@ -1298,6 +1311,12 @@ gamma = 2.2
             ("[[lights]]\nkind = \"spot\"", 2, "unknown variant"),
             ("[[lights]]\ndirection = [0,0,1]", 1, "missing field `kind`"),
             ("[render]\ngamma = \"s-rgb\"", 2, "srgb"),
+            (
+                "[render]\ntone_curve = \"sepia\"",
+                2,
+                "unknown variant `sepia`",
+            ),
+            ("[render]\nglow = \"yes\"", 2, "invalid type"),
             ("[camera]\nposition = [1, 2]", 2, ""),
             ("lights = 3", 1, "invalid type"),
         ] {
@@ -1333,6 +1352,11 @@ gamma = 2.2
             ("[skin]\nmix = 1.5", "skin.mix = 1.5"),
             ("[skin]\nmix = -0.1", "skin.mix"),
             ("[skin]\nmix = nan", "skin.mix = NaN"),
+            ("[skin]\nblur_width = -1", "skin.blur_width = -1"),
+            ("[skin]\nblur_width = 11", "skin.blur_width = 11"),
+            ("[skin]\nblur_amount = 1.5", "skin.blur_amount = 1.5"),
+            ("[render]\nglow_intensity = -1", "render.glow_intensity = -1"),
+            ("[render]\nbackground = [0, 2, 0]", "render.background.g = 2"),
             (
                 "[skin]\nprofile = [{ variance_mm2 = 1, weights = [0.5, 1, 1] }]",
                 "red weights sum to 0.5",
