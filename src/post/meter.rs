@@ -3,7 +3,7 @@
 //! L̄ = exp(mean log(δ + L)) (Reinhard, Stark, Shirley & Ferwerda 2002, eq. 1),
 //! mapped to the key 0.18 of a normal-key scene (ibid. §3.1): exposure =
 //! log2(0.18 / L̄) EV. On the GPU two timed passes, `meter` (one partial sum
-//! per 16 × 16 tile) and `meter_reduce` (one workgroup), write the EV into a
+//! per 32 × 32 tile) and `meter_reduce` (one workgroup), write the EV into a
 //! buffer the tone-map pass reads in the same frame; `render/` reads it back
 //! afterwards. [`exposure`] is the CPU reference.
 
@@ -25,8 +25,8 @@ pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 pub const COVERED: f32 = 0.5;
 /// Bytes of the result: EV, L̄, pixels metered, 0 (f32 each).
 pub const RESULT_BYTES: u64 = 16;
-/// Side of the tiles `meter` sums (meter.comp's workgroup).
-const TILE: u32 = 16;
+/// Side of the tiles `meter` sums (meter.comp: 8 × 8 threads of 4 × 4 pixels).
+const TILE: u32 = 32;
 
 /// What a metering found.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,7 +101,7 @@ pub struct Meter {
     partials: Arc<Buffer>,
     /// [`RESULT_BYTES`]: what the tone map reads.
     result: Arc<Buffer>,
-    tile_count: u32,
+    tiles_xy: [u32; 2],
 }
 
 impl Meter {
@@ -111,7 +111,8 @@ impl Meter {
         (width, height): (u32, u32),
         sampler: Arc<Sampler>,
     ) -> Result<Self> {
-        let tile_count = width.div_ceil(TILE) * height.div_ceil(TILE);
+        let tiles_xy = [width.div_ceil(TILE), height.div_ceil(TILE)];
+        let tile_count = tiles_xy[0] * tiles_xy[1];
         let buffer = |name: &str, size: u64, extra| {
             Buffer::new(
                 ctx,
@@ -132,7 +133,7 @@ impl Meter {
                 vk::BufferUsageFlags::empty(),
             )?,
             result: buffer("exposure", RESULT_BYTES, vk::BufferUsageFlags::TRANSFER_SRC)?,
-            tile_count,
+            tiles_xy,
         })
     }
 
@@ -164,12 +165,12 @@ impl Meter {
                 delta: DELTA,
                 covered: COVERED,
             })
-            .dispatch([hdr.desc.width, hdr.desc.height, 1]);
+            .dispatch_groups([self.tiles_xy[0], self.tiles_xy[1], 1]);
         g.simple_pass("meter_reduce", &self.reduce)
             .read_buffer(&partials)
             .write_buffer(&mut result)
             .constants(&ReducePush {
-                tiles: self.tile_count,
+                tiles: self.tiles_xy[0] * self.tiles_xy[1],
                 key: KEY,
             })
             .dispatch_groups([1, 1, 1]);
