@@ -231,13 +231,13 @@ enum Command {
         #[arg(long, value_enum)]
         tone_curve: Option<ToneCurve>,
         /// Glow (d'Eon & Luebke's two-Gaussian bloom), replacing `render.glow`.
-        #[arg(long, value_name = "on|off", value_parser = clap::builder::BoolishValueParser::new())]
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
         glow: Option<bool>,
         /// Glow intensity (≥ 0), replacing `render.glow_intensity`.
         #[arg(long, allow_hyphen_values = true)]
         glow_intensity: Option<f32>,
         /// Draw the environment behind the head, replacing `render.skybox`.
-        #[arg(long, value_name = "on|off", value_parser = clap::builder::BoolishValueParser::new())]
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
         skybox: Option<bool>,
         /// Display colour (linear, each in [0, 1]) where the skybox is off and
         /// the mesh does not cover, replacing `render.background`.
@@ -252,7 +252,7 @@ enum Command {
         #[arg(long, allow_hyphen_values = true)]
         blur_amount: Option<f32>,
         /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
-        #[arg(long, value_name = "on|off", value_parser = clap::builder::BoolishValueParser::new())]
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
         test_texture: Option<bool>,
         /// Side of the UV-space irradiance texture (power of two, 256..8192).
         #[arg(long)]
