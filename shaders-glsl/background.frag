@@ -1,5 +1,6 @@
 #version 460
-// The environment seen through the camera, behind the mesh.
+// The environment seen through the camera, behind the mesh. Alpha 0: the HDR
+// image's alpha is the mesh's coverage (post/meter.rs meters by it).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "envmap.glsl"
@@ -12,5 +13,5 @@ void main() {
     vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 dir = far.xyz / far.w - frame.camera_pos.xyz;
     vec3 radiance = textureLod(env_tex, equirect_uv(env_dir(dir, frame.env.x)), 0.0).rgb;
-    color = vec4(radiance * frame.env.y, 1.0);
+    color = vec4(radiance * frame.env.y, 0.0);
 }

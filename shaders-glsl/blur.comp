@@ -39,6 +39,11 @@ void main() {
                          : src_size / vec2(size);
     bool along_u = pc.dir.x != 0;
     float sigma_texels = pc.sigma_mm * (along_u ? s.x : s.y);
+    // σ = 0 (skin.blur_width = 0 on the stretch chain): a copy.
+    if (sigma_texels <= 0.0) {
+        imageStore(dst, p, textureLod(src, uv, 0.0));
+        return;
+    }
     // One source texel along the blur axis, in normalised coordinates.
     vec2 texel = vec2(pc.dir) / src_size;
     vec4 sum = vec4(0.0);

@@ -10,27 +10,29 @@
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 #define SHADOW_ATLAS 3
-#define SOFT_VISIBILITY 17
+#define SOFT_VISIBILITY 18
 #include "lights.glsl"
 // binding 4: the per-vertex transfer, read by mesh_lit.vert.
 #define ENV_SPECULAR 5
 #include "env_specular.glsl"
-layout(binding = 6) uniform sampler2D blur1;
-layout(binding = 7) uniform sampler2D blur2;
-layout(binding = 8) uniform sampler2D blur3;
-layout(binding = 9) uniform sampler2D blur4;
-layout(binding = 10) uniform sampler2D blur5;
-layout(binding = 11) uniform sampler2D blur6;
-#define SPEC_BECKMANN 12
-#define SPEC_ALBEDO 13
-#define SPEC_REGIONS 14
-#define SPEC_INTENSITY 15
-#define SPEC_ROUGHNESS 16
+layout(binding = 6) uniform sampler2D irradiance;
+layout(binding = 7) uniform sampler2D blur1;
+layout(binding = 8) uniform sampler2D blur2;
+layout(binding = 9) uniform sampler2D blur3;
+layout(binding = 10) uniform sampler2D blur4;
+layout(binding = 11) uniform sampler2D blur5;
+layout(binding = 12) uniform sampler2D blur6;
+#define SPEC_BECKMANN 13
+#define SPEC_ALBEDO 14
+#define SPEC_REGIONS 15
+#define SPEC_INTENSITY 16
+#define SPEC_ROUGHNESS 17
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
-// mode: 0 final, 1 diffuse only, 2 specular only.
-layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; } pc;
+// mode: 0 final, 1 diffuse only, 2 specular only. blur_amount: the share of the
+// blurred levels, the rest the unblurred irradiance (the paper's menu).
+layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; float blur_amount; } pc;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -40,14 +42,17 @@ layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
 layout(location = 0) out vec4 color;
 
-vec3 level(sampler2D t, int i) {
+// A UV target at v_uv, normalised by its coverage.
+vec3 lookup(sampler2D t) {
     vec4 b = textureLod(t, v_uv, 0.0);
-    return pc.weights[i].rgb * (b.rgb / max(b.a, 1e-4));
+    return b.rgb / max(b.a, 1e-4);
 }
 
 void main() {
-    vec3 diffuse = level(blur1, 0) + level(blur2, 1) + level(blur3, 2)
-                 + level(blur4, 3) + level(blur5, 4) + level(blur6, 5);
+    vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
+                 + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
+                 + pc.weights[4].rgb * lookup(blur5) + pc.weights[5].rgb * lookup(blur6);
+    vec3 diffuse = mix(lookup(irradiance), blurred, pc.blur_amount);
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.

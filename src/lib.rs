@@ -15,6 +15,7 @@ pub mod scene;
 pub mod skin;
 pub mod sweep;
 pub mod testscene;
+pub mod text;
 pub mod viewer;
 
 pub use error::{Error, Result};

@@ -3,11 +3,12 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::light::extract;
-use dermis::render::{render, RenderOptions, View};
+use dermis::render::output::{write_sheet, Format};
+use dermis::render::{compare_occlusion, debug_sheet, render_scene, RenderOptions, View};
 use dermis::scene::file::{
-    default_scene_path, scene_by_name, Chain, Kernel, LightsMode, Occlusion, UvOrigin,
+    default_scene_path, scene_by_name, Chain, Kernel, LightsMode, Occlusion, ToneCurve, UvOrigin,
 };
-use dermis::scene::Overrides;
+use dermis::scene::{Overrides, Scene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -256,9 +257,38 @@ enum Command {
         /// sources holding ≥ 5 % of the energy) or a count 0..=8 (0: none).
         #[arg(long, value_name = "auto|N", allow_hyphen_values = true)]
         env_lights: Option<LightsMode>,
-        /// Exposure in EV stops.
+        /// Exposure in EV stops, replacing `render.exposure`; without either it is
+        /// metered from the frame (the skin's log-average luminance to 0.18).
         #[arg(long, allow_hyphen_values = true)]
         exposure: Option<f32>,
+        /// Tone curve, replacing `render.tone_curve`: `linear` (clip), `aces`
+        /// (Narkowicz's ACES fit) or `neutral` (Khronos PBR Neutral).
+        #[arg(long, value_enum)]
+        tone_curve: Option<ToneCurve>,
+        /// Glow (d'Eon & Luebke's two-Gaussian bloom), replacing `render.glow`.
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
+        glow: Option<bool>,
+        /// Glow intensity (≥ 0), replacing `render.glow_intensity`.
+        #[arg(long, allow_hyphen_values = true)]
+        glow_intensity: Option<f32>,
+        /// Draw the environment behind the head, replacing `render.skybox`.
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
+        skybox: Option<bool>,
+        /// Display colour (linear, each in [0, 1]) where the skybox is off and
+        /// the mesh does not cover, replacing `render.background`.
+        #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
+        background: Option<[f32; 3]>,
+        /// Scale on the profile's six variances (the paper's blurring width; 0:
+        /// no blur), replacing `skin.blur_width`.
+        #[arg(long, allow_hyphen_values = true)]
+        blur_width: Option<f32>,
+        /// Share of the blurred irradiance in the diffuse term, 0..1 (the
+        /// paper's blurring amount; 0: unblurred), replacing `skin.blur_amount`.
+        #[arg(long, allow_hyphen_values = true)]
+        blur_amount: Option<f32>,
+        /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
+        #[arg(long, value_name = "on|off", hide_possible_values = true, value_parser = clap::builder::BoolishValueParser::new())]
+        test_texture: Option<bool>,
         /// Side of the UV-space irradiance texture (power of two, 256..8192).
         #[arg(long)]
         irradiance_res: Option<u32>,
@@ -286,6 +316,14 @@ enum Command {
         /// the irradiance resolution, as stored).
         #[arg(long, value_enum, default_value = "final")]
         view: View,
+        /// Also write the debug sheet (PNG): the stretch and blur levels (the
+        /// paper's Fig. 3), depth, occlusion and specular, labelled.
+        #[arg(long, value_name = "FILE.png")]
+        debug_sheet: Option<PathBuf>,
+        /// Also write --view with occlusion on and off side by side (PNG, one
+        /// exposure; the paper's Figs. 6–8).
+        #[arg(long, value_name = "FILE.png")]
+        compare_occlusion: Option<PathBuf>,
         /// Frames to render (≥ 1); with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
@@ -311,6 +349,17 @@ enum Command {
         #[arg(long)]
         ruler: bool,
     },
+}
+
+/// `--background R,G,B`.
+fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{s:?}: {e}"))?;
+    v.try_into()
+        .map_err(|_| format!("{s:?}: expected three numbers R,G,B"))
 }
 
 fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String> {
@@ -692,6 +741,14 @@ fn run(cli: Cli) -> dermis::Result<()> {
             env_rotate,
             env_lights,
             exposure,
+            tone_curve,
+            glow,
+            glow_intensity,
+            skybox,
+            background,
+            blur_width,
+            blur_amount,
+            test_texture,
             irradiance_res,
             occlusion,
             kernel,
@@ -700,6 +757,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
             width,
             height,
             view,
+            debug_sheet: sheet,
+            compare_occlusion: comparison,
             frames,
             timings,
             report,
@@ -723,19 +782,31 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 uv_origin,
                 width,
                 height,
+                blur_width,
+                blur_amount,
+                test_texture,
+                tone_curve,
+                skybox,
+                background,
+                glow,
+                glow_intensity,
             };
-            let hdr =
-                dermis::render::output::Format::of(&out)? == dermis::render::output::Format::Exr;
-            let output = render(&RenderOptions {
-                scene: overrides.apply(file)?,
+            let hdr = Format::of(&out)? == Format::Exr;
+            for path in [&sheet, &comparison].into_iter().flatten() {
+                Format::of(path)?;
+            }
+            let file = overrides.apply(file)?;
+            let loaded = Scene::load(file)?;
+            let ctx = Context::new(&context)?;
+            let opts = RenderOptions {
                 frames,
                 hdr,
                 view,
-                context,
                 scene_path: Some(scene.unwrap_or_else(default_scene_path)),
                 progress: std::io::stderr().is_terminal(),
                 ruler,
-            })?;
+            };
+            let output = render_scene(&ctx, &loaded, &opts)?;
             if dump_graph {
                 print!("{}", output.plan);
             }
@@ -764,7 +835,24 @@ fn run(cli: Cli) -> dermis::Result<()> {
             if let Some(path) = csv {
                 write_file(&path, &dermis::profile::csv::csv(r))?;
             }
-            println!("wrote {}", out.display());
+            println!(
+                "wrote {} (exposure {:+.2} EV, {})",
+                out.display(),
+                output.exposure,
+                if output.metered.is_some() {
+                    "metered"
+                } else {
+                    "given"
+                }
+            );
+            if let Some(path) = sheet {
+                write_sheet(&path, &debug_sheet(&ctx, &loaded, &opts)?)?;
+                println!("wrote {}", path.display());
+            }
+            if let Some(path) = comparison {
+                write_sheet(&path, &compare_occlusion(&ctx, &loaded, &opts)?)?;
+                println!("wrote {}", path.display());
+            }
             Ok(())
         }
     }

@@ -375,6 +375,121 @@ fn bad_scene_input_is_a_clean_error() {
 }
 
 #[test]
+fn bad_post_and_blur_settings_name_their_key() {
+    assert_bad_input(&["--glow-intensity", "-1"], "render.glow_intensity = -1");
+    assert_bad_input(
+        &["--tone-curve", "sepia"],
+        "invalid value 'sepia' for '--tone-curve",
+    );
+    assert_bad_input(&["--blur-width", "-0.5"], "skin.blur_width = -0.5");
+    assert_bad_input(&["--blur-amount", "2"], "skin.blur_amount = 2");
+    assert_bad_input(&["--background", "2,0,0"], "render.background.r = 2");
+    assert_bad_input(&["--background", "1,0"], "expected three numbers R,G,B");
+    assert_bad_input(&["--glow", "maybe"], "invalid value 'maybe' for '--glow");
+    let toml = tmp("bad-post.toml");
+    std::fs::write(&toml, "[render]\nglow_intensity = -2\n").unwrap();
+    assert_bad_input(
+        &["--scene", toml.to_str().unwrap()],
+        "render.glow_intensity = -2",
+    );
+    std::fs::write(&toml, "[render]\ntone_curve = \"sepia\"\n").unwrap();
+    assert_bad_input(&["--scene", toml.to_str().unwrap()], "line 2");
+    std::fs::write(&toml, "[skin]\nblur_width = -1\n").unwrap();
+    assert_bad_input(&["--scene", toml.to_str().unwrap()], "skin.blur_width = -1");
+    assert_bad_input(
+        &["--debug-sheet", tmp("sheet.jpg").to_str().unwrap()],
+        "unsupported output format",
+    );
+}
+
+#[test]
+fn debug_sheet_comparison_and_post_settings_from_the_command_line() {
+    let (png, sheet, comparison, json) = (
+        tmp("post.png"),
+        tmp("sheet.png"),
+        tmp("occlusion.png"),
+        tmp("post.json"),
+    );
+    let out = dermis(&[
+        "render",
+        "--out",
+        png.to_str().unwrap(),
+        "--irradiance-res",
+        "256",
+        "--width",
+        "96",
+        "--height",
+        "120",
+        "--tone-curve",
+        "neutral",
+        "--glow",
+        "on",
+        "--glow-intensity",
+        "0.5",
+        "--skybox",
+        "off",
+        "--background",
+        "0.2,0.3,0.4",
+        "--blur-width",
+        "2",
+        "--blur-amount",
+        "0.8",
+        "--test-texture",
+        "on",
+        "--debug-sheet",
+        sheet.to_str().unwrap(),
+        "--compare-occlusion",
+        comparison.to_str().unwrap(),
+        "--report",
+        json.to_str().unwrap(),
+        "--timings",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("EV, metered)"), "{stdout}");
+    assert!(stdout.contains("tone curve neutral, glow 0.5"), "{stdout}");
+    // The glow's passes are timed on their own.
+    for pass in [
+        "meter",
+        "meter_reduce",
+        "glow_down1",
+        "glow1_u",
+        "glow2_v",
+        "glow",
+    ] {
+        assert!(
+            stdout.contains(&format!("\n{pass} ")),
+            "no {pass} in\n{stdout}"
+        );
+    }
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let setup = &r["setup"];
+    assert_eq!(setup["tone_curve"], "neutral");
+    assert_eq!(setup["glow_intensity"], 0.5);
+    assert_eq!(setup["blur_width"], 2.0);
+    assert_eq!(setup["blur_amount"], 0.8);
+    assert_eq!(setup["test_texture"], true);
+    assert_eq!(setup["exposure_metered"], true);
+    assert!(setup["exposure_ev"].as_f64().is_some_and(f64::is_finite));
+    // The background shows where the mesh does not: the top-left corner.
+    let img = image::open(&png).unwrap().to_rgba8();
+    let corner = img.get_pixel(0, 0).0;
+    assert!(
+        (corner[2] as i32 - 170).abs() < 6 && corner[0] < corner[1],
+        "{corner:?}"
+    );
+    let (w, h) = image::image_dimensions(&sheet).unwrap();
+    assert_eq!(w, 6 * 256, "{w}x{h}");
+    assert_eq!(image::image_dimensions(&comparison).unwrap().0, 2 * 96);
+}
+
+#[test]
 fn views_write_intermediates() {
     // UV-space views come out at the irradiance resolution, floats kept in EXR.
     let exr = tmp("stretch.exr");
@@ -416,10 +531,16 @@ fn views_write_intermediates() {
     for view in [
         "blur6",
         "irradiance",
+        "stretch3",
         "diffuse",
         "specular",
         "direct",
         "occlusion",
+        "depth",
+        "normals",
+        "albedo",
+        "regions",
+        "test-texture",
         "prefiltered",
     ] {
         let png = tmp(&format!("{view}.png"));
@@ -443,7 +564,7 @@ fn views_write_intermediates() {
         );
         let size = image::image_dimensions(&png).unwrap();
         let want = match view {
-            "blur6" | "irradiance" => (256, 256),
+            "blur6" | "irradiance" | "stretch3" => (256, 256),
             "prefiltered" => (128, 512),
             _ => (64, 48),
         };
@@ -598,6 +719,16 @@ fn help_documents_every_flag_the_environment_and_exit_codes() {
     let help = String::from_utf8_lossy(&dermis(&["render", "--help"]).stdout).to_string();
     for value in [
         "blur6",
+        "stretch5",
+        "test-texture",
+        "regions",
+        "neutral",
+        "--debug-sheet",
+        "--compare-occlusion",
+        "--blur-width",
+        "--blur-amount",
+        "--glow-intensity",
+        "--background",
         "prefiltered",
         "raytrace",
         "bottom-left",

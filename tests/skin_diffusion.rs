@@ -77,7 +77,8 @@ fn chain_with(
             None,
         );
         let st = stretch.pass(&mut g, &buffers, &blur, true);
-        let levels = blur.chain(&mut g, input, &st, &plan);
+        let blurred = blur.chain(&mut g, &input, &st, &plan);
+        let levels = BlurChain::select(&input, &blurred, &plan);
         for (level, buf) in levels.iter().zip(&readbacks) {
             buf.image_pass(&mut g, level);
         }
@@ -296,4 +297,113 @@ fn flux_is_conserved_on_a_closed_chart() {
         change * 100.0
     );
     assert!(change < 0.01, "flux changed by {change}");
+}
+
+/// The diffuse term of the built-in head under a shadowed light (sharp edges
+/// for the blur to soften), without specular (every region's ρs = 0, so no
+/// energy goes to it), occlusion or texture detail (a uniform albedo, a flat
+/// normal map: the screen and the UV space would sample them differently),
+/// with `skin` changed by `set`; or, `direct`, the screen-space Lambert term
+/// albedo/π · E of the same scene (light::direct), which is what the diffuse
+/// term is with no blur at all.
+fn diffuse_term(set: impl Fn(&mut dermis::scene::file::Skin), direct: bool) -> Vec<f32> {
+    use dermis::render::{render_scene, RenderOptions, View};
+    use dermis::scene::file::{Light, LightKind, Occlusion, SceneFile, SpecularRegion};
+    let mut file = SceneFile::default();
+    let dir = std::env::temp_dir().join(format!("dermis-blur-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, rgb) in [
+        ("albedo.png", [188, 140, 120]),
+        ("normal.png", [128, 128, 255]),
+    ] {
+        let rgba = [rgb[0], rgb[1], rgb[2], 255];
+        image::save_buffer(dir.join(name), &rgba, 1, 1, image::ExtendedColorType::Rgba8).unwrap();
+    }
+    file.textures.albedo = Some(dir.join("albedo.png"));
+    file.textures.normal = Some(dir.join("normal.png"));
+    file.environment.source = "uniform:0.05,0.05,0.05".parse().unwrap();
+    file.environment.lights = dermis::scene::file::LightsMode::Count(0);
+    file.lights = vec![Light {
+        kind: LightKind::Directional,
+        direction: Some([-0.7, -0.3, -0.6]),
+        position: None,
+        color: [1.0, 1.0, 1.0],
+        intensity: 1.0,
+        shadow: true,
+        angular_diameter_deg: 0.0,
+    }];
+    file.skin.occlusion = Occlusion::Off;
+    file.skin.regions = Some(
+        (0..10)
+            .map(|i| SpecularRegion {
+                name: format!("r{i}"),
+                rho_s: 0.0,
+                m: 0.3,
+            })
+            .collect(),
+    );
+    set(&mut file.skin);
+    file.render.width = 128;
+    file.render.height = 160;
+    file.render.irradiance_resolution = 1024;
+    file.render.exposure = Some(0.0);
+    file.render.skybox = false;
+    let scene = dermis::scene::Scene::load(file).unwrap();
+    common::with_gpu(|ctx| {
+        let opts = RenderOptions {
+            hdr: true,
+            view: if direct { View::Direct } else { View::Diffuse },
+            ..RenderOptions::default()
+        };
+        render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()
+    })
+}
+
+/// Mean |a − b| over the pixels both cover, relative to b's mean (luminance).
+fn mean_difference(a: &[f32], b: &[f32]) -> f64 {
+    let luma = |p: &[f32]| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64;
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        if p[3] > 0.5 && q[3] > 0.5 {
+            diff += (luma(p) - luma(q)).abs();
+            sum += luma(q);
+        }
+    }
+    diff / sum
+}
+
+#[test]
+fn blur_width_zero_and_blur_amount_zero_give_the_unblurred_irradiance() {
+    let direct = diffuse_term(|_| {}, true);
+    let blurred = diffuse_term(|_| {}, false);
+    let no_width = diffuse_term(|s| s.blur_width = 0.0, false);
+    let no_amount = diffuse_term(|s| s.blur_amount = 0.0, false);
+    let half = diffuse_term(|s| s.blur_amount = 0.5, false);
+    let mid: Vec<f32> = blurred
+        .iter()
+        .zip(&no_amount)
+        .map(|(a, b)| 0.5 * (a + b))
+        .collect();
+    let e = |a: &[f32], b: &[f32]| 100.0 * mean_difference(a, b);
+    println!(
+        "mean |Δ| relative to the mean, over the head: width 0 vs direct {:.2} %, amount 0 vs \
+         direct {:.2} %, width 0 vs amount 0 {:.3} %, blurred vs direct {:.2} %, amount 0.5 vs \
+         the mean of blurred and unblurred {:.3} %",
+        e(&no_width, &direct),
+        e(&no_amount, &direct),
+        e(&no_width, &no_amount),
+        e(&blurred, &direct),
+        e(&half, &mid),
+    );
+    // Both settings read the irradiance texture unblurred: the same image up
+    // to f16 rounding and the profile weights' sums (1 ± 0.001).
+    assert!(mean_difference(&no_width, &no_amount) < 0.002);
+    // And that is the irradiance-derived Lambert term, up to sampling the
+    // irradiance at 1024² instead of per pixel.
+    assert!(mean_difference(&no_width, &direct) < 0.03);
+    // The blur moves light across the shadow edge and around the curvature:
+    // measurably further from the Lambert term.
+    assert!(mean_difference(&blurred, &direct) > 2.0 * mean_difference(&no_width, &direct));
+    // The amount mixes linearly.
+    assert!(mean_difference(&half, &mid) < 0.001);
 }

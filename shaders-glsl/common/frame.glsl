@@ -8,7 +8,7 @@ layout(std140, binding = 0) uniform Frame {
     mat4 light_shadow[8];   // world → (atlas u, v, depth) after the divide by w
     vec4 light_params[8];   // x: tan(angular radius), y: shadow depth range mm, z: m² widening
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
-    vec4 params;            // x: exposure (EV), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
+    vec4 params;            // x: 0 (free), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;
 // Fixed for a render (frame::ShaderVariant): the driver unrolls the light loop and
 // drops dead branches, which a CPU driver would otherwise run with masked lanes.

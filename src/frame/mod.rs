@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 /// What every frame reads that does not change during a render.
 pub struct FrameInputs {
-    /// [`FrameUniforms`]: camera, lights, environment rotation, exposure.
+    /// [`FrameUniforms`]: camera, lights, environment rotation.
     pub uniforms: Arc<Buffer>,
     pub mesh: Arc<MeshBuffers>,
     pub albedo: Arc<Image>,

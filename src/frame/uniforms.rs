@@ -56,7 +56,7 @@ pub struct FrameUniforms {
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],
-    /// x: exposure (EV); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
+    /// x: 0 (free); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
     /// (skin::specular::map_rho_s); z, w: the shadow atlas's tile columns and rows.
     pub params: [f32; 4],
 }

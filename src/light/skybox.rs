@@ -30,8 +30,9 @@ impl SkyboxPass {
         Ok(Self { pipeline })
     }
 
-    /// Clears `hdr` to the environment behind the camera.
-    /// The environment behind everything, or (`sky` false) transparent black.
+    /// Clears `hdr` to the environment behind the camera, or (`sky` false) to
+    /// transparent black; alpha 0 either way, so the mesh's passes make alpha
+    /// its coverage.
     pub fn pass(&self, g: &mut Graph, inputs: &FrameInputs, hdr: &mut ImageHandle, sky: bool) {
         if !sky {
             let mut p = g.add_pass("background");

@@ -1,4 +1,71 @@
-//! Post-processing after shading: exposure and tone mapping (glow and debug
-//! views join here).
+//! Post-processing after shading (the paper's §IV; docs/post.md): metering,
+//! glow, exposure and tone mapping, and the debug views drawn for it.
 
+pub mod debug;
+pub mod glow;
+pub mod meter;
 pub mod tonemap;
+
+use crate::scene::file::{Gamma, Render, ToneCurve};
+
+/// Where the exposure comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Exposure {
+    /// `render.exposure`, EV.
+    Given(f32),
+    /// The frame's own log-average luminance (post::meter).
+    Metered,
+}
+
+/// How exposed radiance becomes display values: the tone-map pass's settings
+/// and those of its CPU twin ([`tonemap::encode8`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Display {
+    pub curve: ToneCurve,
+    pub gamma: Gamma,
+    /// Display colour (linear, before `gamma`) added where the image's alpha
+    /// (the mesh's coverage) is below 1.
+    pub background: [f32; 3],
+}
+
+impl Display {
+    /// Values shown as they are: no curve, no transfer function (normals,
+    /// depth, region ids).
+    pub fn data(background: [f32; 3]) -> Display {
+        Display {
+            curve: ToneCurve::Linear,
+            gamma: Gamma::Power(1.0),
+            background,
+        }
+    }
+}
+
+/// The post-processing settings of a render, resolved once from `[render]`;
+/// plain values, so a viewer can change them between frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PostSettings {
+    /// Glow intensity; `None`: off.
+    pub glow: Option<f32>,
+    pub exposure: Exposure,
+    pub display: Display,
+}
+
+impl PostSettings {
+    pub fn resolve(render: &Render) -> PostSettings {
+        PostSettings {
+            glow: render.glow.then_some(render.glow_intensity),
+            exposure: render.exposure.map_or(Exposure::Metered, Exposure::Given),
+            display: Display {
+                curve: render.tone_curve,
+                gamma: render.gamma,
+                // The skybox leaves alpha at 0 too: the background is for
+                // images without one.
+                background: if render.skybox {
+                    [0.0; 3]
+                } else {
+                    render.background
+                },
+            },
+        }
+    }
+}

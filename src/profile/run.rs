@@ -40,6 +40,21 @@ pub struct RunSetup {
     pub environment_lights: String,
     /// Bright sources taken out of the environment as lights.
     pub extracted_lights: usize,
+    /// The exposure used, EV (post::meter when metered).
+    pub exposure_ev: f32,
+    /// Whether it was metered from the frame (else given, or 0 for a view of
+    /// fractions or data).
+    pub exposure_metered: bool,
+    /// `linear`, `aces` or `neutral`.
+    pub tone_curve: String,
+    /// Glow intensity; 0: off.
+    pub glow_intensity: f32,
+    /// Scale on the profile's variances.
+    pub blur_width: f32,
+    /// Share of the blurred irradiance in the diffuse term.
+    pub blur_amount: f32,
+    /// The test texture replaced the albedo.
+    pub test_texture: bool,
 }
 
 /// Device memory at the end of the run.
@@ -193,13 +208,14 @@ impl RunReport {
         }
     }
 
-    /// Two lines: the device and the setup.
+    /// Three lines: the device, the setup and the post-processing.
     pub fn header(&self) -> String {
         let s = &self.setup;
         format!(
             "{} ({}), API {}, LP_NUM_THREADS={}, dermis {} ({})\n\
              {} {}x{} (render {}x{}), irradiance {}², kernel {}, chain {}, occlusion {}, \
-             mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} frame(s), {} warm-up\n",
+             mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} frame(s), {} warm-up\n\
+             exposure {:+.2} EV ({}), tone curve {}, glow {}, blur width {}, blur amount {}{}\n",
             self.device,
             self.driver.trim(),
             self.api_version,
@@ -222,6 +238,21 @@ impl RunReport {
             s.environment_lights,
             self.frames,
             self.warmup_frames,
+            s.exposure_ev,
+            if s.exposure_metered {
+                "metered"
+            } else {
+                "given"
+            },
+            s.tone_curve,
+            if s.glow_intensity > 0.0 {
+                s.glow_intensity.to_string()
+            } else {
+                "off".into()
+            },
+            s.blur_width,
+            s.blur_amount,
+            if s.test_texture { ", test texture" } else { "" },
         )
     }
 

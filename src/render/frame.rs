@@ -3,6 +3,7 @@
 //! final image or a debug view.
 
 use super::ruler::Ruler;
+use super::view::Shown;
 use super::View;
 use crate::error::{Error, Result};
 use crate::frame::{
@@ -11,7 +12,7 @@ use crate::frame::{
 };
 use crate::gpu::{Context, ImageDesc};
 use crate::graph::upload::upload_buffer;
-use crate::graph::{Access, Graph, ImageHandle};
+use crate::graph::{Access, BufferHandle, Graph, ImageHandle};
 use crate::light::direct::{DirectPass, DirectView};
 use crate::light::extract::{extract, ExtractedLight};
 use crate::light::prefilter::PrefilterPass;
@@ -19,8 +20,13 @@ use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
 use crate::light::skybox::SkyboxPass;
 use crate::light::visibility::VisibilityPass;
+use crate::post::debug::{DebugPass, DebugView, DepthRange};
+use crate::post::glow::Glow;
+use crate::post::meter::Meter;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
-use crate::scene::file::{Gamma, Occlusion};
+use crate::post::{Display, Exposure, PostSettings};
+use crate::scene::file::{Occlusion, ToneCurve};
+use crate::scene::texture::Texture;
 use crate::scene::{Light, LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::chain::{self, Level};
@@ -86,7 +92,7 @@ fn shadow_views(scene: &Scene, lights: &[Light]) -> Vec<Option<ShadowView>> {
 }
 
 /// The frame's uniforms: camera, environment rotation and intensity, lights and
-/// their shadow projections (`views`, from [`shadow_views`]), exposure.
+/// their shadow projections (`views`, from [`shadow_views`]).
 fn frame_uniforms(
     scene: &Scene,
     lights: &[Light],
@@ -115,7 +121,7 @@ fn frame_uniforms(
             },
         ],
         params: [
-            scene.exposure(),
+            0.0,
             0.5 / specular::map_mean(
                 &scene.mesh.positions,
                 &scene.mesh.uvs,
@@ -171,6 +177,11 @@ pub(super) struct Frame {
     shadow_views: Vec<ShadowView>,
     shadow_resolution: u32,
     prefilter: PrefilterPass,
+    debug: DebugPass,
+    /// Where the depth view's 1 and 0 lie.
+    depth_range: DepthRange,
+    meter: Meter,
+    glow: Glow,
     tonemap: Tonemap,
     sh: ShPasses,
     sh_buffers: ShBuffers,
@@ -181,16 +192,17 @@ pub(super) struct Frame {
     ruler: Option<Ruler>,
     /// render.skybox: draw the environment behind the head.
     skybox_on: bool,
-    exposure: f32,
-    gamma: Gamma,
+    pub(super) post: PostSettings,
     /// Bright sources taken out of the environment as lights.
     pub(super) extracted_lights: usize,
 }
 
 impl Frame {
+    /// `albedo`: the scene's, or the test texture (`--view test-texture`).
     pub(super) fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
+        albedo: &Texture,
         skin: SkinSettings,
         ruler: bool,
     ) -> Result<Self> {
@@ -232,7 +244,7 @@ impl Frame {
                 Access::UniformRead,
             )?,
             mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
-            albedo: upload_rgba8(ctx, "albedo", &scene.albedo)?,
+            albedo: upload_rgba8(ctx, "albedo", albedo)?,
             normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
             transfer: upload_buffer(
                 ctx,
@@ -290,6 +302,12 @@ impl Frame {
             skin.chain,
             levels
         );
+        let camera = &scene.camera;
+        let depth_range = DepthRange::of(
+            camera.position,
+            (camera.target - camera.position).normalize_or_zero(),
+            &scene.mesh.positions,
+        );
         Ok(Self {
             tables,
             skybox: SkyboxPass::new(ctx)?,
@@ -305,6 +323,10 @@ impl Frame {
             lights,
             shadow_resolution: scene.file.render.shadow_resolution,
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
+            debug: DebugPass::new(ctx, &scene.regions)?,
+            depth_range,
+            meter: Meter::new(ctx, (w, h), samplers.nearest.clone())?,
+            glow: Glow::new(ctx, samplers.nearest.clone(), samplers.linear.clone())?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
             sh: ShPasses::new(ctx, samplers.nearest.clone())?,
             sh_buffers: ShBuffers::new(
@@ -322,8 +344,7 @@ impl Frame {
                 None
             },
             skybox_on: scene.file.render.skybox,
-            exposure: scene.exposure(),
-            gamma: scene.file.render.gamma,
+            post: PostSettings::resolve(&scene.file.render),
             extracted_lights: extraction.lights.len(),
         })
     }
@@ -342,35 +363,45 @@ impl Frame {
         Ok(())
     }
 
-    /// A UV-space view's image (stored values) encoded for display, with the
-    /// view's exposure: what `render` does on the CPU for such views.
-    pub(super) fn encode(&self, g: &mut Graph, image: &ImageHandle, view: View) -> ImageHandle {
-        let (w, h) = (image.desc.width, image.desc.height);
-        let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
-        self.tonemap
-            .pass(g, image, &mut ldr, self.exposure_for(view), self.gamma);
-        ldr
+    /// The post-processing settings (exposure, tone curve, glow, background)
+    /// replaced: the graph reads them when it is built.
+    pub(super) fn set_post(&mut self, post: PostSettings) {
+        self.post = post;
     }
 
-    /// The occlusion view shows a ratio in [0, 1]: no exposure.
-    pub(super) fn exposure_for(&self, view: View) -> f32 {
-        if view == View::Occlusion {
-            0.0
-        } else {
-            self.exposure
+    /// A UV-space view's image (stored values) encoded for display as the view
+    /// is shown (`render::view::Shown`).
+    pub(super) fn encode(&self, g: &mut Graph, image: ImageHandle, view: View) -> ImageHandle {
+        let images = self.post(g, view, image);
+        images.ldr.expect("post makes the 8-bit image")
+    }
+
+    /// The exposure and display of `view` (render::view::Shown).
+    pub(super) fn display(&self, view: View) -> (Exposure, Display) {
+        let display = self.post.display;
+        match view.shown() {
+            Shown::Exposed => (self.post.exposure, display),
+            Shown::Fraction => (
+                Exposure::Given(0.0),
+                Display {
+                    curve: ToneCurve::Linear,
+                    ..display
+                },
+            ),
+            Shown::Data => (Exposure::Given(0.0), Display::data(display.background)),
         }
     }
 
-    /// Builds the frame graph; returns the image to read back (and its size)
-    /// for `view`, and for screen views the tone-mapped 8-bit image.
-    /// `first`: the render's first frame (it also prefilters the environment).
+    /// Builds the frame graph for `view` at `(w, h)` (UV-space views: their
+    /// image as stored). `first`: the render's first frame (it also projects
+    /// the SH, prefilters the environment and computes the stretch maps).
     pub(super) fn graph(
         &self,
         g: &mut Graph,
         view: View,
         (w, h): (u32, u32),
         first: bool,
-    ) -> (ImageHandle, Option<ImageHandle>) {
+    ) -> FrameImages {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let sh = self.sh.passes(
             g,
@@ -380,10 +411,7 @@ impl Frame {
             first,
         );
         if view == View::Prefiltered {
-            return (
-                self.prefilter.pass(g, &self.inputs.lighting_env, first),
-                None,
-            );
+            return FrameImages::uv(self.prefilter.pass(g, &self.inputs.lighting_env, first));
         }
         let shadows = self.shadow.pass(
             g,
@@ -394,7 +422,18 @@ impl Frame {
         let soft = self
             .visibility
             .pass(g, &self.inputs, &shadows, self.skin.resolution);
-        if let View::Direct | View::Occlusion = view {
+        let debug = match view {
+            View::Depth => Some(DebugView::Depth),
+            View::Normals => Some(DebugView::Normals),
+            View::Albedo => Some(DebugView::Albedo),
+            View::Regions => Some(DebugView::Regions),
+            _ => None,
+        };
+        if let Some(debug) = debug {
+            self.skybox.pass(g, &self.inputs, &mut hdr, false);
+            self.debug
+                .pass(g, debug, &self.inputs, self.depth_range, &mut hdr);
+        } else if let View::Direct | View::Occlusion = view {
             let direct = match view {
                 View::Direct => DirectView::Shading,
                 _ => DirectView::Occlusion,
@@ -415,18 +454,26 @@ impl Frame {
                 res,
                 self.skin.mix,
             );
-            if view == View::Stretch {
-                return (stretch.swap_remove(0), None);
+            if let View::Stretch(k) = view {
+                return FrameImages::uv(stretch.swap_remove(k as usize));
             }
             if view == View::Irradiance {
-                return (irradiance, None);
+                return FrameImages::uv(irradiance);
             }
             if let Some(r) = &self.ruler {
                 r.passes(g, &irradiance);
             }
-            let mut levels = self.blur.chain(g, irradiance, &stretch, &self.levels);
+            let mut blurred = self.blur.chain(g, &irradiance, &stretch, &self.levels);
             if let View::Blur(k) = view {
-                return (levels.swap_remove(k as usize - 1), None);
+                // Level k is the last blur at or before it, or the irradiance.
+                let made = self.levels[..k as usize]
+                    .iter()
+                    .filter(|l| l.sigma_mm.is_some())
+                    .count();
+                return FrameImages::uv(match made {
+                    0 => irradiance,
+                    n => blurred.swap_remove(n - 1),
+                });
             }
             let specular_env = self.prefilter.pass(g, &self.inputs.lighting_env, first);
             self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
@@ -446,6 +493,7 @@ impl Frame {
             let settings = ShadeSettings {
                 weights,
                 mix: self.skin.mix,
+                blur_amount: self.skin.blur_amount,
                 mode,
             };
             self.shade.pass(
@@ -453,7 +501,8 @@ impl Frame {
                 &self.inputs,
                 &self.tables,
                 ShadeImages {
-                    levels: &levels,
+                    irradiance: &irradiance,
+                    levels: &BlurChain::select(&irradiance, &blurred, &self.levels),
                     shadows: &shadows,
                     soft_visibility: &soft,
                     specular_env: &specular_env,
@@ -462,9 +511,56 @@ impl Frame {
                 &mut hdr,
             );
         }
+        self.post(g, view, hdr)
+    }
+
+    /// Metering, glow and tone mapping of a screen view's `hdr`.
+    fn post(&self, g: &mut Graph, view: View, hdr: ImageHandle) -> FrameImages {
+        let (exposure, display) = self.display(view);
+        let exposed = view.shown() == Shown::Exposed;
+        // Metered before the glow: the exposure is the skin's.
+        let metered = (exposure == Exposure::Metered).then(|| self.meter.pass(g, &hdr));
+        let hdr = match self.post.glow {
+            Some(intensity) if exposed => self.glow.pass(g, &hdr, intensity),
+            _ => hdr,
+        };
+        let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));
+        let unwritten;
+        let result = match &metered {
+            Some(m) => m,
+            None => {
+                unwritten = self.meter.result(g);
+                &unwritten
+            }
+        };
         self.tonemap
-            .pass(g, &hdr, &mut ldr, self.exposure_for(view), self.gamma);
-        (hdr, Some(ldr))
+            .pass(g, &hdr, result, &mut ldr, exposure, &display);
+        FrameImages {
+            image: hdr,
+            ldr: Some(ldr),
+            metered,
+        }
+    }
+}
+
+/// The images a frame graph ends with.
+pub(super) struct FrameImages {
+    /// A screen view's HDR image as tone-mapped (after the glow), or a UV-space
+    /// view's image as stored.
+    pub image: ImageHandle,
+    /// A screen view's 8-bit image.
+    pub ldr: Option<ImageHandle>,
+    /// The meter's result (post::meter), when the view was metered.
+    pub metered: Option<BufferHandle>,
+}
+
+impl FrameImages {
+    fn uv(image: ImageHandle) -> Self {
+        Self {
+            image,
+            ldr: None,
+            metered: None,
+        }
     }
 }

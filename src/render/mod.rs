@@ -1,43 +1,45 @@
-//! The `render` command's library side: load the scene, upload it, build the
-//! frame graph, run it for a number of frames, read the image back, and report
-//! per-pass timings.
+//! The `render` command's library side: upload the scene, build the frame
+//! graph, run it for a number of frames, read the image and the exposure back,
+//! and report per-pass timings; the debug sheet and the occlusion comparison.
 
 mod frame;
 pub mod output;
 mod progress;
 pub mod ruler;
 pub mod session;
+pub mod sheet;
 mod view;
 
-pub use view::View;
+pub use view::{Shown, View};
 
 use crate::error::{Error, Result};
-use crate::gpu::{Context, ContextOptions, DeviceInfo};
+use crate::gpu::{Context, DeviceInfo};
 use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph};
 use crate::light::reference::{render_view, ReferenceImage, Settings as ReferenceSettings};
+use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
+use crate::post::{Exposure, PostSettings};
 use crate::profile::{MemoryUse, RunReport, RunSetup};
-use crate::scene::file::{Chain, Kernel, Occlusion, SceneFile};
+use crate::scene::checker;
+use crate::scene::file::{Chain, Kernel, Occlusion};
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
 use frame::Frame;
 use progress::Progress;
+use sheet::Sheet;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
-    /// The scene, with any command-line overrides already applied.
-    pub scene: SceneFile,
     /// Frames to render; with more than one, the first is warm-up and excluded
     /// from the median (lavapipe compiles shaders on first use).
     pub frames: u32,
     /// Also read back the linear HDR image (for EXR output).
     pub hdr: bool,
     pub view: View,
-    pub context: ContextOptions,
-    /// Where `scene` was read from, for the report (`None`: the default scene).
+    /// Where the scene was read from, for the report (`None`: the default scene).
     pub scene_path: Option<PathBuf>,
     /// Show a progress bar on stderr (the caller checks it is a terminal).
     pub progress: bool,
@@ -48,11 +50,9 @@ pub struct RenderOptions {
 impl Default for RenderOptions {
     fn default() -> Self {
         Self {
-            scene: SceneFile::default(),
             frames: 1,
             hdr: false,
             view: View::Final,
-            context: ContextOptions::from_env(),
             scene_path: None,
             progress: false,
             ruler: false,
@@ -60,12 +60,14 @@ impl Default for RenderOptions {
     }
 }
 
-/// What the report says was rendered.
+/// What the report says was rendered: `view` with `exposure` EV (metered or
+/// given).
 fn setup(
     scene: &Scene,
     opts: &RenderOptions,
-    irradiance_resolution: u32,
+    view: View,
     extracted_lights: usize,
+    (exposure_ev, exposure_metered): (f32, bool),
 ) -> RunSetup {
     let f = &scene.file;
     let path = |p: &Option<PathBuf>, none: &str| {
@@ -77,7 +79,7 @@ fn setup(
         mesh: path(&f.mesh, "builtin"),
         environment: f.environment.source.to_string(),
         environment_rotation_deg: f.environment.rotation_deg,
-        irradiance_resolution,
+        irradiance_resolution: f.render.irradiance_resolution,
         kernel: match f.skin.kernel {
             Kernel::Deon7 => "deon7",
             Kernel::Accurate => "accurate",
@@ -88,7 +90,7 @@ fn setup(
             Chain::Adaptive => "adaptive",
         }
         .into(),
-        view: opts.view.name().into(),
+        view: view.name().into(),
         render_width: f.render.width,
         render_height: f.render.height,
         occlusion: match f.skin.occlusion {
@@ -101,19 +103,38 @@ fn setup(
         lights: f.lights.len(),
         environment_lights: f.environment.lights.to_string(),
         extracted_lights,
+        exposure_ev,
+        exposure_metered,
+        tone_curve: format!("{:?}", f.render.tone_curve).to_lowercase(),
+        glow_intensity: if f.render.glow {
+            f.render.glow_intensity
+        } else {
+            0.0
+        },
+        blur_width: f.skin.blur_width,
+        blur_amount: f.skin.blur_amount,
+        test_texture: f.textures.test_texture || view == View::TestTexture,
     }
 }
 
 pub struct RenderOutput {
     pub width: u32,
     pub height: u32,
+    pub view: View,
     /// `--view reference`: how the CPU reference converged (its pixels are in
     /// `rgba8` and `hdr`; `rgba` here is empty).
     pub reference: Option<ReferenceImage>,
     /// sRGB-encoded RGBA8, row-major, top row first.
     pub rgba8: Vec<u8>,
-    /// Linear RGBA radiance × 2^exposure, when asked for.
+    /// Linear RGBA, when asked for: screen views the radiance the tone map
+    /// read (after the glow; alpha = coverage), UV-space views as stored.
     pub hdr: Option<Vec<f32>>,
+    /// The exposure `rgba8` was made with, EV: given, metered (the GPU's, read
+    /// back; a UV-space view's on the CPU), or 0 for fractions and data
+    /// (View::shown). EXR output is `hdr` × 2^exposure for screen views.
+    pub exposure: f32,
+    /// What the meter found, when the exposure was metered.
+    pub metered: Option<Metered>,
     pub report: RunReport,
     /// The compiled plan of the last frame, as `--dump-graph` prints it.
     pub plan: String,
@@ -131,12 +152,7 @@ pub fn check_target(info: &DeviceInfo, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-pub fn render(opts: &RenderOptions) -> Result<RenderOutput> {
-    let scene = Scene::load(opts.scene.clone())?;
-    let ctx = Context::new(&opts.context)?;
-    render_scene(&ctx, &scene, opts)
-}
-
+/// Renders `opts.view` of `scene`.
 pub fn render_scene(
     ctx: &Arc<Context>,
     scene: &Scene,
@@ -147,25 +163,115 @@ pub fn render_scene(
             "frames: 0 frames render nothing; give 1 or more".into(),
         ));
     }
-    let screen = (scene.file.render.width, scene.file.render.height);
-    check_target(&ctx.info, screen.0, screen.1)?;
+    let skin = settings(ctx, scene)?;
+    if opts.view == View::Reference {
+        return reference(ctx, scene, opts);
+    }
+    let test_texture;
+    let albedo = if opts.view == View::TestTexture && !scene.file.textures.test_texture {
+        test_texture = checker::albedo(scene.file.textures.uv_origin);
+        &test_texture
+    } else {
+        &scene.albedo
+    };
+    let frame = Frame::new(ctx, scene, albedo, skin, opts.ruler)?;
+    run(ctx, scene, &frame, opts.view, opts)
+}
+
+/// The skin settings of `scene`, its sizes checked against the device.
+fn settings(ctx: &Arc<Context>, scene: &Scene) -> Result<SkinSettings> {
+    check_target(&ctx.info, scene.file.render.width, scene.file.render.height)?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     check_target(&ctx.info, skin.resolution, skin.resolution)?;
-    if opts.view == View::Reference {
-        return reference(ctx, scene, opts, skin.resolution);
+    Ok(skin)
+}
+
+/// The views of the debug sheet (the paper's Fig. 3 and debug mode), in rows
+/// of [`sheet::COLUMNS`]: the stretch levels, the blur levels, then depth,
+/// occlusion and specular.
+pub const SHEET_VIEWS: [View; 15] = [
+    View::Stretch(0),
+    View::Stretch(1),
+    View::Stretch(2),
+    View::Stretch(3),
+    View::Stretch(4),
+    View::Stretch(5),
+    View::Blur(1),
+    View::Blur(2),
+    View::Blur(3),
+    View::Blur(4),
+    View::Blur(5),
+    View::Blur(6),
+    View::Depth,
+    View::Occlusion,
+    View::Specular,
+];
+
+/// One frame of each view, without progress bar or HDR image.
+fn single(opts: &RenderOptions) -> RenderOptions {
+    RenderOptions {
+        frames: 1,
+        hdr: false,
+        progress: false,
+        ..opts.clone()
     }
-    let resolution = skin.resolution;
-    let frame = Frame::new(ctx, scene, skin, opts.ruler)?;
-    let run_setup = setup(scene, opts, resolution, frame.extracted_lights);
+}
+
+/// The debug sheet: every view of [`SHEET_VIEWS`] rendered (one frame each, on
+/// one upload of the scene) and labelled with its name.
+pub fn debug_sheet(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<Sheet> {
+    let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
+    let tiles = SHEET_VIEWS
+        .iter()
+        .map(|&view| {
+            let out = run(ctx, scene, &frame, view, &single(opts))?;
+            Ok((view.name().to_string(), out))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(sheet::compose(&tiles, sheet::COLUMNS, sheet::TILE))
+}
+
+/// `opts.view` with occlusion on (the scene's method, or `raytrace` where the
+/// scene has it off) and off, side by side (the paper's Figs. 6–8), at one
+/// exposure: the one metered (or given) with occlusion on.
+pub fn compare_occlusion(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<Sheet> {
+    let mut on = scene.clone();
+    if on.file.skin.occlusion == Occlusion::Off {
+        on.file.skin.occlusion = Occlusion::Raytrace;
+    }
+    let with = render_scene(ctx, &on, &single(opts))?;
+    let mut off = on.clone();
+    off.file.skin.occlusion = Occlusion::Off;
+    off.file.render.exposure = Some(with.exposure);
+    let without = render_scene(ctx, &off, &single(opts))?;
+    let method = format!("{:?}", on.file.skin.occlusion).to_lowercase();
+    let size = (with.width, with.height);
+    let tiles = [
+        (format!("{}, occlusion {method}", opts.view.name()), with),
+        (format!("{}, occlusion off", opts.view.name()), without),
+    ];
+    Ok(sheet::compose(&tiles, 2, size))
+}
+
+/// Renders `view` with `frame`, `opts.frames` times; reads back the image(s)
+/// and the exposure.
+fn run(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    frame: &Frame,
+    view: View,
+    opts: &RenderOptions,
+) -> Result<RenderOutput> {
+    let screen = (scene.file.render.width, scene.file.render.height);
     // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
     let (w, h) = {
-        let (image, _) = frame.graph(&mut Graph::new(), opts.view, screen, true);
-        (image.desc.width, image.desc.height)
+        let images = frame.graph(&mut Graph::new(), view, screen, true);
+        (images.image.desc.width, images.image.desc.height)
     };
     let readback = |name: &str, bytes_per_texel: u64| {
         Readback::new(ctx, name, w as u64 * h as u64 * bytes_per_texel)
     };
-    let uv = opts.view.uv_space();
+    let uv = view.uv_space();
     let ldr_readback = if uv {
         None
     } else {
@@ -176,19 +282,26 @@ pub fn render_scene(
     } else {
         None
     };
+    let exposure_readback = Readback::new(ctx, "readback exposure", meter::RESULT_BYTES)?;
 
     let mut executor = Executor::new(ctx, 2)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
+    let mut gpu_metered = false;
     let progress = Progress::new(opts.frames, opts.progress);
     for i in 0..opts.frames {
         let mut g = Graph::new();
-        let (hdr, ldr) = frame.graph(&mut g, opts.view, screen, i == 0);
-        if let (Some(ldr), Some(r)) = (&ldr, &ldr_readback) {
+        let images = frame.graph(&mut g, view, screen, i == 0);
+        if let (Some(ldr), Some(r)) = (&images.ldr, &ldr_readback) {
             r.image_pass(&mut g, ldr);
         }
+        // After the 8-bit readback, which waits for the tone map's reads.
+        if let Some(m) = &images.metered {
+            exposure_readback.buffer_pass(&mut g, m);
+            gpu_metered = true;
+        }
         if let Some(r) = &hdr_readback {
-            r.image_pass(&mut g, &hdr);
+            r.image_pass(&mut g, &images.image);
         }
         let compiled = executor.compile(g)?;
         plan = compiled.plan.to_string();
@@ -197,32 +310,29 @@ pub fn render_scene(
     }
     reports.extend(executor.finish()?);
     drop(progress);
-    let exposure = frame.exposure_for(opts.view);
-    // Screen views: linear radiance × 2^exposure, alpha (coverage) as is. UV
-    // views: the values as stored.
     let hdr = match &hdr_readback {
-        Some(b) => {
-            let scale = if uv { 1.0 } else { exposure.exp2() };
-            Some(
-                b.bytes()?
-                    .chunks_exact(2)
-                    .enumerate()
-                    .map(|(i, c)| {
-                        let v = half::f16::from_le_bytes([c[0], c[1]]).to_f32();
-                        if i % 4 == 3 {
-                            v
-                        } else {
-                            v * scale
-                        }
-                    })
-                    .collect::<Vec<f32>>(),
-            )
-        }
+        Some(b) => Some(
+            b.bytes()?
+                .chunks_exact(2)
+                .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32())
+                .collect::<Vec<f32>>(),
+        ),
         None => None,
+    };
+    let (exposure, display) = frame.display(view);
+    let metered = match (exposure, &hdr) {
+        _ if gpu_metered => Some(Metered::from_bytes(exposure_readback.bytes()?)),
+        // UV-space views are metered here, on the CPU.
+        (Exposure::Metered, Some(values)) if uv => Some(meter::exposure(values)),
+        _ => None,
+    };
+    let ev = match (exposure, metered) {
+        (Exposure::Given(ev), _) => ev,
+        (Exposure::Metered, m) => m.map_or(0.0, |m| m.ev),
     };
     let rgba8 = match (&ldr_readback, &hdr) {
         (Some(b), _) => b.bytes()?.to_vec(),
-        (None, Some(values)) => encode8(values, exposure, scene.file.render.gamma),
+        (None, Some(values)) => encode8(values, ev, &display),
         (None, None) => Vec::new(),
     };
     let (allocated_bytes, reserved_bytes) = ctx.allocator_bytes();
@@ -231,47 +341,53 @@ pub fn render_scene(
         allocated_bytes,
         reserved_bytes,
     };
+    let run_setup = setup(
+        scene,
+        opts,
+        view,
+        frame.extracted_lights,
+        (ev, metered.is_some()),
+    );
     let report = RunReport::new(&ctx.info, run_setup, w, h, reports, memory);
     Ok(RenderOutput {
         width: w,
         height: h,
+        view,
         reference: None,
         rgba8,
         hdr,
+        exposure: ev,
+        metered,
         report,
         plan,
     })
 }
 
 /// `--view reference`: the CPU reference of the direct view
-/// (light::reference::render_view), exposed and encoded like the GPU's image;
-/// its report has no passes.
-fn reference(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    opts: &RenderOptions,
-    resolution: u32,
-) -> Result<RenderOutput> {
+/// (light::reference::render_view), exposed (given, or metered on the CPU) and
+/// encoded as the GPU's image would be; its report has no passes.
+fn reference(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     let (w, h) = (scene.file.render.width, scene.file.render.height);
     let mut image = render_view(scene, w, h, &ReferenceSettings::default())?;
-    let exposure = scene.exposure();
-    let rgba8 = encode8(&image.rgba, exposure, scene.file.render.gamma);
-    let scale = exposure.exp2();
-    let hdr = opts.hdr.then(|| {
-        image
-            .rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
-            .collect()
-    });
-    image.rgba = Vec::new();
-    let setup = setup(scene, opts, resolution, 0);
+    let post = PostSettings::resolve(&scene.file.render);
+    let metered = (post.exposure == Exposure::Metered).then(|| meter::exposure(&image.rgba));
+    let ev = match post.exposure {
+        Exposure::Given(ev) => ev,
+        Exposure::Metered => metered.map_or(0.0, |m| m.ev),
+    };
+    let rgba8 = encode8(&image.rgba, ev, &post.display);
+    let rgba = std::mem::take(&mut image.rgba);
+    let hdr = opts.hdr.then_some(rgba);
+    let setup = setup(scene, opts, View::Reference, 0, (ev, metered.is_some()));
     Ok(RenderOutput {
         width: w,
         height: h,
+        view: View::Reference,
         reference: Some(image),
         rgba8,
         hdr,
+        exposure: ev,
+        metered,
         report: RunReport::new(&ctx.info, setup, w, h, Vec::new(), MemoryUse::default()),
         plan: String::new(),
     })

@@ -1,5 +1,7 @@
-//! Writing rendered images: PNG (8-bit sRGB) or EXR (linear float), by extension.
+//! Writing rendered images: PNG (8-bit, as tone-mapped) or EXR (linear float),
+//! by extension.
 
+use super::sheet::Sheet;
 use super::RenderOutput;
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -27,18 +29,44 @@ impl Format {
     }
 }
 
+/// The 8-bit image as PNG, or the linear one as EXR: a screen view's radiance
+/// × 2^exposure (alpha: coverage), a UV-space view's values as stored.
 pub fn write(path: &Path, out: &RenderOutput) -> Result<()> {
     let (w, h) = (out.width, out.height);
     match Format::of(path)? {
-        Format::Png => image::save_buffer(path, &out.rgba8, w, h, image::ExtendedColorType::Rgba8)
-            .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display()))),
+        Format::Png => write_png(path, w, h, &out.rgba8),
         Format::Exr => {
             let hdr = out.hdr.as_ref().ok_or_else(|| {
                 Error::Input(format!("{}: no HDR image was rendered", path.display()))
             })?;
-            write_exr(path, w, h, hdr)
+            let scale = if out.view.uv_space() {
+                1.0
+            } else {
+                out.exposure.exp2()
+            };
+            let exposed: Vec<f32> = hdr
+                .chunks_exact(4)
+                .flat_map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
+                .collect();
+            write_exr(path, w, h, &exposed)
         }
     }
+}
+
+/// A debug sheet or comparison (render::sheet), as PNG.
+pub fn write_sheet(path: &Path, sheet: &Sheet) -> Result<()> {
+    if Format::of(path)? != Format::Png {
+        return Err(Error::Input(format!(
+            "{}: a sheet is written as .png",
+            path.display()
+        )));
+    }
+    write_png(path, sheet.width, sheet.height, &sheet.rgba8)
+}
+
+fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
+    image::save_buffer(path, rgba8, width, height, image::ExtendedColorType::Rgba8)
+        .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display())))
 }
 
 /// Linear RGBA f32, row-major, top row first.

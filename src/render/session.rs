@@ -4,14 +4,14 @@
 //! only makes the frame's uniforms again; anything else is a new session.
 
 use super::frame::Frame;
-use super::{check_target, View};
+use super::{check_target, settings, View};
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc};
 use crate::graph::{Access, Executor, Graph, Imported};
+use crate::post::PostSettings;
 use crate::profile::FrameReport;
 use crate::scene::camera::Camera;
 use crate::scene::Scene;
-use crate::skin::SkinSettings;
 use ash::vk;
 use std::sync::Arc;
 
@@ -26,12 +26,10 @@ pub struct Session {
 }
 
 impl Session {
+    /// A session of `scene`; its `textures.test_texture` puts the checker on.
     pub fn new(ctx: &Arc<Context>, scene: Scene) -> Result<Self> {
-        let render = &scene.file.render;
-        check_target(&ctx.info, render.width, render.height)?;
-        let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
-        check_target(&ctx.info, skin.resolution, skin.resolution)?;
-        let frame = Frame::new(ctx, &scene, skin, false)?;
+        let skin = settings(ctx, &scene)?;
+        let frame = Frame::new(ctx, &scene, &scene.albedo, skin, false)?;
         Ok(Self {
             ctx: ctx.clone(),
             executor: Executor::new(ctx, 1)?,
@@ -50,6 +48,12 @@ impl Session {
         self.frame.extracted_lights
     }
 
+    /// Replaces the post-processing settings (`render`'s exposure, tone curve,
+    /// glow, background): read when the next frame's graph is built.
+    pub fn set_post(&mut self, render: &crate::scene::file::Render) {
+        self.frame.set_post(PostSettings::resolve(render));
+    }
+
     /// Moves the camera and sets the frame's size (its aspect): uniforms only.
     pub fn set_camera(&mut self, camera: Camera, (width, height): (u32, u32)) -> Result<()> {
         check_target(&self.ctx.info, width, height)?;
@@ -65,10 +69,10 @@ impl Session {
     pub fn render(&mut self, view: View) -> Result<(Arc<Image>, Option<FrameReport>)> {
         let size = (self.scene.file.render.width, self.scene.file.render.height);
         let mut g = Graph::new();
-        let (hdr, ldr) = self.frame.graph(&mut g, view, size, self.first);
-        let ldr = match ldr {
+        let images = self.frame.graph(&mut g, view, size, self.first);
+        let ldr = match images.ldr {
             Some(ldr) => ldr,
-            None => self.frame.encode(&mut g, &hdr, view),
+            None => self.frame.encode(&mut g, images.image, view),
         };
         let (w, h) = (ldr.desc.width, ldr.desc.height);
         let image = Arc::new(Image::new(

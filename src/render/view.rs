@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 /// What `render` writes: the final image or one intermediate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum View {
-    /// The final image: texture-space diffusion (+ specular when it lands).
+    /// The final image: texture-space diffusion and specular.
     Final,
     /// The diffuse (subsurface) term alone.
     Diffuse,
@@ -19,10 +19,21 @@ pub enum View {
     Reference,
     /// The per-vertex transfer's DC term relative to open sky (1 = unoccluded).
     Occlusion,
+    /// Linear depth over the mesh's bounding sphere (post::debug).
+    Depth,
+    /// The shading normal after the normal map, world space, 0.5·n + 0.5.
+    Normals,
+    /// The albedo map on the mesh.
+    Albedo,
+    /// The face-region ids in distinct colours.
+    Regions,
+    /// The final image with the numbered UV checker as the albedo (scene::checker).
+    TestTexture,
     /// UV-space irradiance (coverage-premultiplied, as stored).
     Irradiance,
-    /// UV-space stretch map (texels per mm in R and G; alpha = coverage).
-    Stretch,
+    /// UV-space stretch level 0 (unblurred) ..= 5 (texels per mm in R and G;
+    /// alpha = coverage).
+    Stretch(u8),
     /// UV-space blur level 1..=6 (as stored).
     Blur(u8),
     /// The KS-prefiltered environment: its roughness levels stacked top to bottom
@@ -30,17 +41,45 @@ pub enum View {
     Prefiltered,
 }
 
+/// How a view's image becomes display values (render/: post::Display).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shown {
+    /// Radiance: glow, the exposure (given or metered), the scene's tone curve
+    /// and transfer function.
+    Exposed,
+    /// A fraction in [0, 1] (occlusion, albedo): exposure 0, no curve, the
+    /// scene's transfer function.
+    Fraction,
+    /// Data (depth, normals, region colours): the values as they are.
+    Data,
+}
+
+const STRETCH: [&str; 6] = [
+    "stretch", "stretch1", "stretch2", "stretch3", "stretch4", "stretch5",
+];
+const BLUR: [&str; 6] = ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"];
+
 impl View {
     /// Every view, in the order `--help` lists them.
-    pub const ALL: [View; 15] = [
+    pub const ALL: [View; 25] = [
         View::Final,
         View::Diffuse,
         View::Specular,
         View::Direct,
         View::Reference,
         View::Occlusion,
+        View::Depth,
+        View::Normals,
+        View::Albedo,
+        View::Regions,
+        View::TestTexture,
         View::Irradiance,
-        View::Stretch,
+        View::Stretch(0),
+        View::Stretch(1),
+        View::Stretch(2),
+        View::Stretch(3),
+        View::Stretch(4),
+        View::Stretch(5),
         View::Blur(1),
         View::Blur(2),
         View::Blur(3),
@@ -50,7 +89,8 @@ impl View {
         View::Prefiltered,
     ];
 
-    /// The command-line name: `final`, …, `blur1`…`blur6`, `prefiltered`.
+    /// The command-line name: `final`, …, `stretch`, `stretch1`…`stretch5`,
+    /// `blur1`…`blur6`, `prefiltered`.
     pub fn name(self) -> &'static str {
         match self {
             View::Final => "final",
@@ -59,11 +99,14 @@ impl View {
             View::Direct => "direct",
             View::Reference => "reference",
             View::Occlusion => "occlusion",
+            View::Depth => "depth",
+            View::Normals => "normals",
+            View::Albedo => "albedo",
+            View::Regions => "regions",
+            View::TestTexture => "test-texture",
             View::Irradiance => "irradiance",
-            View::Stretch => "stretch",
-            View::Blur(k) => {
-                ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"][(k.clamp(1, 6) - 1) as usize]
-            }
+            View::Stretch(k) => STRETCH[k.min(5) as usize],
+            View::Blur(k) => BLUR[(k.clamp(1, 6) - 1) as usize],
             View::Prefiltered => "prefiltered",
         }
     }
@@ -83,8 +126,17 @@ impl View {
     pub fn uv_space(self) -> bool {
         matches!(
             self,
-            View::Irradiance | View::Stretch | View::Blur(_) | View::Prefiltered
+            View::Irradiance | View::Stretch(_) | View::Blur(_) | View::Prefiltered
         )
+    }
+
+    /// How the view is shown.
+    pub fn shown(self) -> Shown {
+        match self {
+            View::Occlusion | View::Albedo => Shown::Fraction,
+            View::Depth | View::Normals | View::Regions => Shown::Data,
+            _ => Shown::Exposed,
+        }
     }
 }
 
@@ -108,7 +160,10 @@ mod tests {
             assert_eq!(View::parse(v.name()).unwrap(), v);
         }
         assert_eq!(View::parse("blur4").unwrap(), View::Blur(4));
+        assert_eq!(View::parse("stretch").unwrap(), View::Stretch(0));
+        assert_eq!(View::parse("stretch5").unwrap(), View::Stretch(5));
         let e = View::parse("blur7").unwrap_err().to_string();
         assert!(e.contains("blur6") && e.contains("prefiltered"), "{e}");
+        assert!(View::parse("stretch6").is_err());
     }
 }

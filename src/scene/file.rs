@@ -113,6 +113,9 @@ pub struct Textures {
     pub regions: Option<PathBuf>,
     /// Which corner of the maps the UV origin is; applies to every map given.
     pub uv_origin: UvOrigin,
+    /// Replace the albedo by the numbered UV checker (`texture::test_texture`;
+    /// the paper's "toggle test texture").
+    pub test_texture: bool,
 }
 
 /// The texture corner at UV (0, 0), i.e. the image row that v = 0 samples.
@@ -472,6 +475,12 @@ pub struct Skin {
     /// Correct blur widths for UV distortion with the stretch map (the paper's
     /// section II.B); off: one texels-per-mm constant for the whole mesh.
     pub stretch_correction: bool,
+    /// Scale on every variance of the profile (the paper's "blurring width";
+    /// 0: no blur).
+    pub blur_width: f32,
+    /// Share of the blurred irradiance in the diffuse term, the rest unblurred
+    /// (the paper's "blurring amount"; 0: unblurred).
+    pub blur_amount: f32,
 }
 
 impl Default for Skin {
@@ -484,8 +493,24 @@ impl Default for Skin {
             regions: None,
             occlusion: Occlusion::Raytrace,
             stretch_correction: true,
+            blur_width: 1.0,
+            blur_amount: 1.0,
         }
     }
+}
+
+/// The tone curve from exposed radiance to display values in [0, 1]
+/// (post::tonemap, docs/post.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ToneCurve {
+    /// Clip to [0, 1].
+    #[default]
+    Linear,
+    /// Narkowicz's fit of the ACES filmic curve (RRT + sRGB ODT).
+    Aces,
+    /// Khronos PBR Neutral (2024).
+    Neutral,
 }
 
 /// Output transfer function.
@@ -537,12 +562,20 @@ pub struct Render {
     /// Side of each light's shadow map (power of two, 256..=8192).
     pub shadow_resolution: u32,
     /// Exposure in EV (stops): output = radiance × 2^exposure. `None`: metered
-    /// from the environment (see `Scene::exposure`).
+    /// from the rendered frame (post::meter).
     pub exposure: Option<f32>,
     pub gamma: Gamma,
-    /// Draw the environment behind the head; off: transparent black, so the
-    /// image's alpha is the mesh's coverage (`dermis sweep` masks with it).
+    pub tone_curve: ToneCurve,
+    /// Draw the environment behind the head (its alpha stays 0: the HDR image's
+    /// alpha is the mesh's coverage either way).
     pub skybox: bool,
+    /// Display colour (linear, before the transfer function) where the mesh
+    /// does not cover the image and the skybox is off.
+    pub background: [f32; 3],
+    /// d'Eon & Luebke's glow (post::glow).
+    pub glow: bool,
+    /// Multiplier of the glow kernel.
+    pub glow_intensity: f32,
 }
 
 impl Default for Render {
@@ -554,7 +587,11 @@ impl Default for Render {
             shadow_resolution: 2048,
             exposure: None,
             gamma: Gamma::Srgb,
+            tone_curve: ToneCurve::Linear,
             skybox: true,
+            background: [0.0; 3],
+            glow: false,
+            glow_intensity: 1.0,
         }
     }
 }
@@ -830,12 +867,18 @@ impl Light {
     }
 }
 
+/// Largest `skin.blur_width`: ten times the variances is σ₆ ≈ 8.6 mm, a blur
+/// across the whole cheek.
+pub const MAX_BLUR_WIDTH: f32 = 10.0;
+
 /// Allowed deviation of each channel's profile weight sum from 1.
 pub const PROFILE_SUM_TOLERANCE: f32 = 0.01;
 
 impl Skin {
     fn validate(&self) -> Result<(), String> {
         in_range("skin.mix", self.mix, 0.0, 1.0)?;
+        in_range("skin.blur_width", self.blur_width, 0.0, MAX_BLUR_WIDTH)?;
+        in_range("skin.blur_amount", self.blur_amount, 0.0, 1.0)?;
         if let Some(profile) = &self.profile {
             validate_profile(profile)?;
         }
@@ -919,7 +962,10 @@ impl Render {
                 return Err(format!("render.gamma = {g}: must be in (0, 10]"));
             }
         }
-        Ok(())
+        for (c, v) in ["r", "g", "b"].iter().zip(self.background) {
+            in_range(&format!("render.background.{c}"), v, 0.0, 1.0)?;
+        }
+        non_negative("render.glow_intensity", self.glow_intensity)
     }
 }
 
@@ -1042,6 +1088,8 @@ shadow = false
 mix = 0.25
 kernel = "accurate"
 occlusion = "off"
+blur_width = 0.5
+blur_amount = 0.75
 profile = [
   { variance_mm2 = 0.01, weights = [0.5, 0.5, 0.5] },
   { variance_mm2 = 1.0, weights = [0.5, 0.5, 0.5] },
@@ -1053,6 +1101,11 @@ height = 480
 irradiance_resolution = 1024
 exposure = -1.5
 gamma = 2.2
+tone_curve = "neutral"
+skybox = false
+background = [0.1, 0.2, 0.3]
+glow = true
+glow_intensity = 0.5
 "#;
         let s = parse(text).unwrap();
         assert_eq!(s.mesh, Some(PathBuf::from("/scenes/meshes/head.glb")));
@@ -1081,6 +1134,12 @@ gamma = 2.2
         assert_eq!(s.skin.profile.as_ref().map(Vec::len), Some(2));
         assert_eq!(s.render.gamma, Gamma::Power(2.2));
         assert_eq!(s.render.exposure, Some(-1.5));
+        assert_eq!(s.render.tone_curve, ToneCurve::Neutral);
+        assert!(!s.render.skybox && s.render.glow);
+        assert_eq!(s.render.background, [0.1, 0.2, 0.3]);
+        assert_eq!(s.render.glow_intensity, 0.5);
+        assert_eq!((s.skin.blur_width, s.skin.blur_amount), (0.5, 0.75));
+        assert!(!s.textures.test_texture);
 
         // Orbit: yaw 30, pitch 10, 600 mm from the centre.
         let centre = Vec3::new(1.0, 2.0, 3.0);
@@ -1252,6 +1311,12 @@ gamma = 2.2
             ("[[lights]]\nkind = \"spot\"", 2, "unknown variant"),
             ("[[lights]]\ndirection = [0,0,1]", 1, "missing field `kind`"),
             ("[render]\ngamma = \"s-rgb\"", 2, "srgb"),
+            (
+                "[render]\ntone_curve = \"sepia\"",
+                2,
+                "unknown variant `sepia`",
+            ),
+            ("[render]\nglow = \"yes\"", 2, "invalid type"),
             ("[camera]\nposition = [1, 2]", 2, ""),
             ("lights = 3", 1, "invalid type"),
         ] {
@@ -1287,6 +1352,11 @@ gamma = 2.2
             ("[skin]\nmix = 1.5", "skin.mix = 1.5"),
             ("[skin]\nmix = -0.1", "skin.mix"),
             ("[skin]\nmix = nan", "skin.mix = NaN"),
+            ("[skin]\nblur_width = -1", "skin.blur_width = -1"),
+            ("[skin]\nblur_width = 11", "skin.blur_width = 11"),
+            ("[skin]\nblur_amount = 1.5", "skin.blur_amount = 1.5"),
+            ("[render]\nglow_intensity = -1", "render.glow_intensity = -1"),
+            ("[render]\nbackground = [0, 2, 0]", "render.background.g = 2"),
             (
                 "[skin]\nprofile = [{ variance_mm2 = 1, weights = [0.5, 1, 1] }]",
                 "red weights sum to 0.5",

@@ -2,6 +2,7 @@
 //! the environment, camera and lights, from a TOML scene file plus CLI overrides.
 
 pub mod camera;
+pub mod checker;
 pub mod env;
 pub mod file;
 pub mod gltf;
@@ -44,6 +45,14 @@ pub struct Overrides {
     pub uv_origin: Option<UvOrigin>,
     pub width: Option<u32>,
     pub height: Option<u32>,
+    pub blur_width: Option<f32>,
+    pub blur_amount: Option<f32>,
+    pub test_texture: Option<bool>,
+    pub tone_curve: Option<file::ToneCurve>,
+    pub skybox: Option<bool>,
+    pub background: Option<[f32; 3]>,
+    pub glow: Option<bool>,
+    pub glow_intensity: Option<f32>,
 }
 
 impl Overrides {
@@ -76,6 +85,14 @@ impl Overrides {
         file.textures.uv_origin = self.uv_origin.unwrap_or(file.textures.uv_origin);
         file.render.width = self.width.unwrap_or(file.render.width);
         file.render.height = self.height.unwrap_or(file.render.height);
+        file.skin.blur_width = self.blur_width.unwrap_or(file.skin.blur_width);
+        file.skin.blur_amount = self.blur_amount.unwrap_or(file.skin.blur_amount);
+        file.textures.test_texture = self.test_texture.unwrap_or(file.textures.test_texture);
+        file.render.tone_curve = self.tone_curve.unwrap_or(file.render.tone_curve);
+        file.render.skybox = self.skybox.unwrap_or(file.render.skybox);
+        file.render.background = self.background.unwrap_or(file.render.background);
+        file.render.glow = self.glow.unwrap_or(file.render.glow);
+        file.render.glow_intensity = self.glow_intensity.unwrap_or(file.render.glow_intensity);
         file.validate()
             .map_err(|m| crate::Error::Input(format!("command line: {m}")))?;
         Ok(file)
@@ -126,6 +143,7 @@ impl Light {
 }
 
 /// A scene loaded into memory, in millimetres.
+#[derive(Clone)]
 pub struct Scene {
     pub mesh: Mesh,
     pub albedo: Texture,
@@ -190,6 +208,11 @@ impl Scene {
                 (head.mesh, albedo, normal, regions)
             }
         };
+        let albedo = if t.test_texture {
+            checker::albedo(t.uv_origin)
+        } else {
+            albedo
+        };
         // A flipped normal map's +Y points toward increasing v (Mesh::negate_bitangent_sign).
         if bottom_left && t.normal.is_some() {
             mesh.negate_bitangent_sign();
@@ -240,24 +263,6 @@ impl Scene {
             camera,
             lights,
             file,
-        })
-    }
-}
-
-impl Scene {
-    /// Exposure in EV: the scene's, or metered from the environment so that its
-    /// mean radiance (× intensity) maps to 0.6 before the sRGB curve. A
-    /// reflected-light meter's rule, chosen so that the built-in sky (in kcd/m²)
-    /// and the CC0 maps (mean 0.3–1) both render without tuning.
-    pub fn exposure(&self) -> f32 {
-        self.file.render.exposure.unwrap_or_else(|| {
-            let mean = self.env.mean() * self.file.environment.intensity;
-            let luminance = mean.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
-            if luminance > 0.0 && luminance.is_finite() {
-                (0.6 / luminance).log2()
-            } else {
-                0.0
-            }
         })
     }
 }

@@ -75,30 +75,46 @@ impl BlurChain {
         })
     }
 
-    /// The irradiance levels 1..=6 as `levels` plans them; level k's taps are
-    /// spaced by `stretch[k − 1]`. A level without a σ is its predecessor's image
-    /// (the first: `irradiance` itself).
+    /// The blurred levels `levels` plans, in order (a level without a σ adds
+    /// none: see [`BlurChain::select`]); level k's taps are spaced by
+    /// `stretch[k − 1]`.
     pub fn chain(
         &self,
         g: &mut Graph,
-        irradiance: ImageHandle,
+        irradiance: &ImageHandle,
         stretch: &[ImageHandle],
         levels: &[Level],
     ) -> Vec<ImageHandle> {
         let mut out: Vec<ImageHandle> = Vec::new();
-        let mut unblurred = Some(irradiance);
         for (k, level) in levels.iter().enumerate() {
             let Some(sigma) = level.sigma_mm else {
-                // Only a first level can be skipped (skin::chain::plan).
-                out.extend(unblurred.take());
                 continue;
             };
             let name = format!("blur{}", k + 1);
             let desc = ImageDesc::new(level.resolution, level.resolution, UV_FORMAT);
             let mut dst = g.create_image(&name, desc);
-            let src = out.last().or(unblurred.as_ref()).expect("a source level");
+            let src = out.last().unwrap_or(irradiance);
             self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
             out.push(dst);
+        }
+        out
+    }
+
+    /// The image of each of the six levels: the level's own blur, or for a
+    /// level without a σ its predecessor's (the first's: the irradiance).
+    pub fn select<'a>(
+        irradiance: &'a ImageHandle,
+        blurred: &'a [ImageHandle],
+        levels: &[Level],
+    ) -> Vec<&'a ImageHandle> {
+        let mut next = blurred.iter();
+        let mut out: Vec<&ImageHandle> = Vec::new();
+        for level in levels {
+            let previous = out.last().copied().unwrap_or(irradiance);
+            out.push(match level.sigma_mm {
+                Some(_) => next.next().unwrap_or(previous),
+                None => previous,
+            });
         }
         out
     }

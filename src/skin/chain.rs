@@ -26,7 +26,8 @@ pub struct Level {
     /// Side of the level's image.
     pub resolution: u32,
     /// σ (mm) of the blur from the previous level's image to this one; `None`:
-    /// the level is the previous image, unblurred.
+    /// the level is the previous image, unblurred (an adaptive first level under
+    /// [`SKIP_SIGMA_TEXELS`], or any level of a profile scaled to zero width).
     pub sigma_mm: Option<f32>,
 }
 
@@ -38,6 +39,11 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
     for (k, g) in profile.gaussians.iter().enumerate() {
         let increment = (g.variance_mm2 - previous_variance).max(0.0).sqrt();
         let level = match chain {
+            // `skin.blur_width = 0`: every level is the irradiance.
+            _ if increment == 0.0 => Level {
+                resolution: previous_resolution,
+                sigma_mm: None,
+            },
             Chain::Full => Level {
                 resolution,
                 sigma_mm: Some(increment),
@@ -131,6 +137,23 @@ mod tests {
         let full = blurred_texels(&plan(&p, Chain::Full, res, stretch), res);
         let adaptive = blurred_texels(&levels, res);
         assert!(adaptive * 8 < full, "{adaptive} vs {full}");
+    }
+
+    #[test]
+    fn a_profile_of_zero_width_is_not_blurred() {
+        let mut p = Profile::skin();
+        p.gaussians.iter_mut().for_each(|g| g.variance_mm2 = 0.0);
+        for chain in [Chain::Full, Chain::Adaptive] {
+            for l in plan(&p, chain, 1024, 4.0) {
+                assert_eq!(
+                    l,
+                    Level {
+                        resolution: 1024,
+                        sigma_mm: None
+                    }
+                );
+            }
+        }
     }
 
     #[test]

@@ -30,7 +30,12 @@ pub const UV_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// `[render]`: defaults filled in, checked against what the passes support.
 #[derive(Clone, Debug)]
 pub struct SkinSettings {
+    /// The diffusion profile with `skin.blur_width` applied to its variances
+    /// (the paper's "blurring width"; all 0: no blur).
     pub profile: Profile,
+    /// Share of the blurred irradiance in the diffuse term, the rest unblurred
+    /// (the paper's "blurring amount").
+    pub blur_amount: f32,
     /// KS parameters of the ten face regions (specular::REGION_NAMES order).
     pub regions: Vec<SpecularRegion>,
     pub kernel: BlurKernel,
@@ -68,6 +73,10 @@ impl SkinSettings {
         profile
             .validate()
             .map_err(|e| Error::Input(format!("skin profile: {e}")))?;
+        let mut profile = profile;
+        for g in &mut profile.gaussians {
+            g.variance_mm2 *= skin.blur_width;
+        }
         let regions = skin.regions.clone().unwrap_or_else(|| {
             specular::default_regions()
                 .iter()
@@ -80,6 +89,7 @@ impl SkinSettings {
         });
         Ok(Self {
             profile,
+            blur_amount: skin.blur_amount,
             regions,
             kernel: match skin.kernel {
                 KernelChoice::Deon7 => BlurKernel::Fixed(Kernel::deon7()),

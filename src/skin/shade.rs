@@ -16,6 +16,7 @@ struct ShadePush {
     weights: [[f32; 4]; 6],
     mix_pre: f32,
     mode: u32,
+    blur_amount: f32,
 }
 
 /// The profile weights, albedo split and output of the final pass.
@@ -25,13 +26,17 @@ pub struct ShadeSettings {
     pub weights: [glam::Vec3; 6],
     /// Pre-scatter share of the albedo.
     pub mix: f32,
+    /// Share of the blurred levels in the diffuse term (SkinSettings::blur_amount).
+    pub blur_amount: f32,
     pub mode: ShadeMode,
 }
 
 /// The frame's images the final pass reads.
 pub struct ShadeImages<'a> {
-    /// The six blur levels.
-    pub levels: &'a [ImageHandle],
+    /// The unblurred irradiance.
+    pub irradiance: &'a ImageHandle,
+    /// The six blur levels (skin::blur::BlurChain::select).
+    pub levels: &'a [&'a ImageHandle],
     /// The lights' shadow atlas (light::shadow).
     pub shadows: &'a ImageHandle,
     /// The soft lights' visibility textures (light::visibility).
@@ -107,8 +112,8 @@ impl ShadePass {
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
-        // specular environment, six blur levels, the specular bindings, the soft
-        // lights' visibility.
+        // specular environment, irradiance, six blur levels, the specular
+        // bindings, the soft lights' visibility.
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -116,7 +121,8 @@ impl ShadePass {
             .texture(&inputs.normal, &s.linear)
             .sample(images.shadows, &s.shadow)
             .buffer(&inputs.transfer)
-            .sample(images.specular_env, &s.linear);
+            .sample(images.specular_env, &s.linear)
+            .sample(images.irradiance, &s.linear);
         for level in images.levels {
             pass = pass.sample(level, &s.linear);
         }
@@ -131,6 +137,7 @@ impl ShadePass {
                 weights: settings.weights.map(|w| w.extend(0.0).into()),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
+                blur_amount: settings.blur_amount,
             });
         inputs.mesh.draw(pass);
     }

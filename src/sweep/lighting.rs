@@ -13,7 +13,9 @@ use super::metric::{relative, RelativeError};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::light::reference::{render_view, Settings};
+use crate::post::meter;
 use crate::post::tonemap::encode8;
+use crate::post::{Exposure, PostSettings};
 use crate::render::output::write_exr;
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::env::EnvSource;
@@ -80,8 +82,6 @@ pub fn run(
         file.render.height = opts.height;
         let mut scene = Scene::load(file)?;
         let reference = render_view(&scene, opts.width, opts.height, &opts.settings)?;
-        // dermis's HDR output is radiance × 2^exposure; the reference's is radiance.
-        let scale = scene.exposure().exp2();
         let mut direct = |lights: LightsMode| -> Result<(Vec<f32>, usize)> {
             scene.file.environment.lights = lights;
             let out = render_scene(
@@ -93,12 +93,10 @@ pub fn run(
                     ..RenderOptions::default()
                 },
             )?;
-            let hdr = out.hdr.unwrap_or_default();
-            let linear = hdr
-                .chunks_exact(4)
-                .flat_map(|p| [p[0] / scale, p[1] / scale, p[2] / scale, p[3]])
-                .collect();
-            Ok((linear, out.report.setup.extracted_lights))
+            Ok((
+                out.hdr.unwrap_or_default(),
+                out.report.setup.extracted_lights,
+            ))
         };
         let (sh9, _) = direct(LightsMode::Count(0))?;
         let (lit, extracted) = direct(LightsMode::Auto)?;
@@ -123,9 +121,13 @@ pub fn run(
             write_exr(&name("reference.exr"), w, h, &reference.rgba)?;
             write_exr(&name("sh9.exr"), w, h, &sh9)?;
             write_exr(&name("sh9-lights.exr"), w, h, &lit)?;
-            let exposure = scene.exposure();
-            let gamma = scene.file.render.gamma;
-            let images = [&reference.rgba, &sh9, &lit].map(|i| encode8(i, exposure, gamma));
+            // All three at the reference's exposure (given, or metered on it).
+            let post = PostSettings::resolve(&scene.file.render);
+            let exposure = match post.exposure {
+                Exposure::Given(ev) => ev,
+                Exposure::Metered => meter::exposure(&reference.rgba).ev,
+            };
+            let images = [&reference.rgba, &sh9, &lit].map(|i| encode8(i, exposure, &post.display));
             let row_bytes = 4 * w as usize;
             let side_by_side: Vec<u8> = (0..h as usize)
                 .flat_map(|y| {

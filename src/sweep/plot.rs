@@ -8,8 +8,6 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// DejaVu Sans (assets/fonts, Bitstream Vera licence): PNG text needs a font file.
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (1200, 760);
 
 fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -19,7 +17,7 @@ fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
 /// Writes `time_vs_error.{svg,png}` and `passes.{svg,png}` into `dir`.
 pub fn write_plots(sweep: &Sweep, dir: &Path) -> Result<()> {
     // Registering twice is harmless; the bitmap backend looks fonts up by family.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+    plotters::style::register_font("sans-serif", FontStyle::Normal, crate::text::FONT)
         .map_err(|_| plot_error(dir, "the embedded font does not load"))?;
     for stem in ["time_vs_error", "passes"] {
         let svg = dir.join(format!("{stem}.svg"));

@@ -140,25 +140,44 @@ fn render(
     session: &mut Option<(SceneFile, Session)>,
     job: &Job,
 ) -> Result<Frame> {
-    let settings = without_camera(&job.file);
+    let mut file = job.file.clone();
+    // The test-texture view is the final image with the checker as albedo.
+    file.textures.test_texture |= job.view == View::TestTexture;
+    let settings = session_settings(&file);
     let rebuilt = session.as_ref().is_none_or(|(made, _)| *made != settings);
     if rebuilt {
         *session = None; // free the old one's memory first
-        let mut file = job.file.clone();
         (file.render.width, file.render.height) = job.size;
-        *session = Some((settings, Session::new(ctx, Scene::load(file)?)?));
+        *session = Some((settings, Session::new(ctx, Scene::load(file.clone())?)?));
     }
     let (_, s) = session.as_mut().expect("made above");
+    s.set_post(&file.render);
     s.set_camera(job.camera, job.size)?;
     let (image, report) = s.render(job.view)?;
     Ok((image, report, s.extracted_lights(), rebuilt))
 }
 
-/// The settings that need a new session when they change: all but the camera
-/// and the size.
-fn without_camera(file: &SceneFile) -> SceneFile {
+/// The settings that need a new session when they change: all but the camera,
+/// the size and the post-processing (exposure, tone curve, glow, background),
+/// which a session takes as they come.
+fn session_settings(file: &SceneFile) -> SceneFile {
     let mut f = file.clone();
-    f.camera = SceneFile::default().camera;
-    (f.render.width, f.render.height) = (0, 0);
+    let default = SceneFile::default();
+    f.camera = default.camera;
+    let r = &mut f.render;
+    (r.width, r.height) = (0, 0);
+    (
+        r.exposure,
+        r.tone_curve,
+        r.glow,
+        r.glow_intensity,
+        r.background,
+    ) = (
+        default.render.exposure,
+        default.render.tone_curve,
+        default.render.glow,
+        default.render.glow_intensity,
+        default.render.background,
+    );
     f
 }

@@ -14,7 +14,8 @@
 //!   faces away from the camera; alpha 1;
 //! - behind it (`background.frag`, `light/skybox.rs`) with `render.skybox`: the
 //!   environment bilinearly sampled along the ray through the far plane,
-//!   `env_dir`-rotated, × intensity, alpha 1; without: (0, 0, 0, 0);
+//!   `env_dir`-rotated, × intensity, alpha 0 (alpha is the coverage); without:
+//!   (0, 0, 0, 0);
 //! - the first `frame::MAX_LIGHTS` lights, as the GPU uploads.
 //!
 //! The albedo is read at mip level 0 where the GPU filters trilinearly across
@@ -125,7 +126,7 @@ pub fn render_view(
                     None if scene.file.render.skybox => {
                         let d = integrator.to_env(far - scene.camera.position);
                         let radiance = texture::env(&scene.env, direction_to_uv(d));
-                        (radiance * environment.intensity).extend(1.0)
+                        (radiance * environment.intensity).extend(0.0)
                     }
                     None => Vec4::ZERO,
                 };
@@ -302,7 +303,7 @@ mod tests {
                             checked += 1;
                         }
                         Some(false) if skybox => {
-                            assert!((p - SKY.extend(1.0)).abs().max_element() < 1e-6, "{p}")
+                            assert!((p - SKY.extend(0.0)).abs().max_element() < 1e-6, "{p}")
                         }
                         Some(false) => assert_eq!(p, Vec4::ZERO),
                         None => {}

@@ -1,0 +1,122 @@
+//! Every view of `dermis render --view`, the debug sheet and the occlusion
+//! comparison render at a small size under validation (no message) on the
+//! built-in head (it has a region map), and none is constant: each shows a
+//! quantity that varies over the head.
+
+mod common;
+
+use dermis::render::sheet::{COLUMNS, TILE};
+use dermis::render::{
+    compare_occlusion, debug_sheet, render_scene, RenderOptions, View, SHEET_VIEWS,
+};
+use dermis::scene::file::SceneFile;
+use dermis::scene::Scene;
+
+const SIZE: (u32, u32) = (96, 120);
+
+fn scene() -> Scene {
+    let mut file = SceneFile::default();
+    file.render.width = SIZE.0;
+    file.render.height = SIZE.1;
+    file.render.irradiance_resolution = 256;
+    Scene::load(file).unwrap()
+}
+
+/// Distinct RGB colours of an RGBA8 image.
+fn colours(rgba8: &[u8]) -> usize {
+    let mut c: Vec<[u8; 3]> = rgba8.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect();
+    c.sort_unstable();
+    c.dedup();
+    c.len()
+}
+
+#[test]
+fn every_view_renders_and_shows_something() {
+    let scene = scene();
+    common::with_gpu(|ctx| {
+        // The reference is the CPU's (tests/reference_gpu.rs, light::reference).
+        for view in View::ALL.into_iter().filter(|&v| v != View::Reference) {
+            let opts = RenderOptions {
+                view,
+                ..RenderOptions::default()
+            };
+            let out = render_scene(ctx, &scene, &opts).unwrap();
+            let n = colours(&out.rgba8);
+            println!(
+                "{:>12}: {}×{}, {n} colours, exposure {:+.2} EV",
+                view.name(),
+                out.width,
+                out.height,
+                out.exposure
+            );
+            assert_eq!(out.rgba8.len(), (out.width * out.height * 4) as usize);
+            if !view.uv_space() {
+                assert_eq!((out.width, out.height), SIZE, "{}", view.name());
+            }
+            // Region ids: ten colours and the background; the rest vary smoothly.
+            let least = if view == View::Regions { 5 } else { 32 };
+            assert!(n >= least, "{}: {n} colours", view.name());
+        }
+    });
+}
+
+#[test]
+fn the_debug_sheet_and_the_occlusion_comparison_are_labelled_images_of_their_views() {
+    let scene = scene();
+    let (sheet, comparison) = common::with_gpu(|ctx| {
+        let opts = RenderOptions::default();
+        (
+            debug_sheet(ctx, &scene, &opts).unwrap(),
+            compare_occlusion(ctx, &scene, &opts).unwrap(),
+        )
+    });
+    let rows = SHEET_VIEWS.len().div_ceil(COLUMNS) as u32;
+    assert_eq!(sheet.width, COLUMNS as u32 * TILE.0);
+    assert!(sheet.height > rows * TILE.1 && sheet.height < rows * (TILE.1 + 40));
+    // Every tile shows its view: many colours inside each tile.
+    let cell_h = sheet.height / rows;
+    for (i, view) in SHEET_VIEWS.iter().enumerate() {
+        let (x0, y0) = ((i % COLUMNS) as u32 * TILE.0, (i / COLUMNS) as u32 * cell_h);
+        let tile: Vec<u8> = (y0..y0 + TILE.1)
+            .flat_map(|y| {
+                let start = ((y * sheet.width + x0) * 4) as usize;
+                sheet.rgba8[start..start + (TILE.0 * 4) as usize].to_vec()
+            })
+            .collect();
+        let n = colours(&tile);
+        assert!(n >= 32, "{}: {n} colours", view.name());
+    }
+    // Side by side at the view's size, labels below; occlusion darkens the
+    // concavities, so the halves differ.
+    assert_eq!(comparison.width, 2 * SIZE.0);
+    assert!(comparison.height > SIZE.1);
+    let half = |left: bool| -> Vec<u8> {
+        (0..SIZE.1)
+            .flat_map(|y| {
+                let x = if left { 0 } else { SIZE.0 };
+                let start = ((y * comparison.width + x) * 4) as usize;
+                comparison.rgba8[start..start + (SIZE.0 * 4) as usize].to_vec()
+            })
+            .collect()
+    };
+    let (on, off) = (half(true), half(false));
+    let differ = on
+        .chunks_exact(4)
+        .zip(off.chunks_exact(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    println!(
+        "sheet {}×{}, comparison {}×{}: {differ} pixels differ",
+        sheet.width, sheet.height, comparison.width, comparison.height
+    );
+    assert!(differ > (SIZE.0 * SIZE.1 / 20) as usize, "{differ}");
+    // The labels are drawn: light text in the strip under the first tile.
+    let strip = (TILE.1..cell_h).flat_map(|y| {
+        let start = ((y * sheet.width) * 4) as usize;
+        sheet.rgba8[start..start + (TILE.0 * 4) as usize].to_vec()
+    });
+    assert!(strip
+        .collect::<Vec<u8>>()
+        .chunks_exact(4)
+        .any(|p| p[0] > 200));
+}
