@@ -1,4 +1,6 @@
-//! The viewer's controls (the paper's menus, Figs. 4–5) in an egui side panel and
+//! The viewer's controls (the paper's menus, Figs. 4–5: exposure, tone curve,
+//! glow, blur width and amount, test texture, skybox, debug views, lighting and
+//! diffusion variants) in an egui side panel and
 //! the same in a right-click menu over the image, the live per-pass timings and
 //! the frame-time graph. The controls edit a scene file and a view; the window
 //! renders again when they change.
@@ -7,7 +9,7 @@ use super::camera::Orbit;
 use crate::profile::FrameReport;
 use crate::render::View;
 use crate::scene::env::EnvSource;
-use crate::scene::file::{Chain, Kernel, LightsMode, Occlusion, SceneFile};
+use crate::scene::file::{Chain, Kernel, LightsMode, Occlusion, SceneFile, ToneCurve};
 use std::collections::VecDeque;
 
 /// Frames the timings are the median of, and the graph shows.
@@ -185,7 +187,22 @@ fn controls(ui: &mut egui::Ui, c: &mut Controls, envs: &[(String, EnvSource)]) {
         ui.add(egui::Slider::new(&mut ev, -8.0..=8.0).text("exposure (EV)"));
         f.render.exposure = Some(ev);
     }
+    egui::ComboBox::from_label("tone curve")
+        .selected_text(format!("{:?}", f.render.tone_curve).to_lowercase())
+        .show_ui(ui, |ui| {
+            for t in [ToneCurve::Linear, ToneCurve::Aces, ToneCurve::Neutral] {
+                ui.selectable_value(&mut f.render.tone_curve, t, format!("{t:?}").to_lowercase());
+            }
+        });
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut f.render.glow, "glow");
+        ui.add_enabled(
+            f.render.glow,
+            egui::Slider::new(&mut f.render.glow_intensity, 0.0..=4.0).text("intensity"),
+        );
+    });
     ui.checkbox(&mut f.render.skybox, "skybox");
+    ui.checkbox(&mut f.textures.test_texture, "test texture");
     ui.separator();
     let current = envs
         .iter()
@@ -230,6 +247,8 @@ fn controls(ui: &mut egui::Ui, c: &mut Controls, envs: &[(String, EnvSource)]) {
             }
         });
     ui.separator();
+    ui.add(egui::Slider::new(&mut f.skin.blur_width, 0.0..=4.0).text("blur width"));
+    ui.add(egui::Slider::new(&mut f.skin.blur_amount, 0.0..=1.0).text("blur amount"));
     egui::ComboBox::from_label("irradiance")
         .selected_text(format!("{}²", f.render.irradiance_resolution))
         .show_ui(ui, |ui| {
