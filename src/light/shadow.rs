@@ -132,24 +132,28 @@ impl ShadowPass {
         Ok(Self { pipeline })
     }
 
-    /// The atlas of `views` (tile `i` = `views[i]`), `resolution` texels a side;
-    /// a cleared 1×1 image when there are none, so the lighting shaders always
-    /// have one to bind.
+    /// The atlas of the lights' `views` (`None`: unshadowed; the shadowed ones
+    /// take tiles in order), `resolution` texels a side; a cleared 1×1 image
+    /// when there are none, so the lighting shaders always have one to bind.
     pub fn pass(
         &self,
         g: &mut Graph,
         mesh: &Arc<MeshBuffers>,
-        views: &[ShadowView],
+        views: &[Option<ShadowView>],
         resolution: u32,
     ) -> ImageHandle {
-        let (cols, rows) = atlas_grid(views.len());
-        let (w, h) = match views.len() {
+        let matrices: Vec<[f32; 16]> = views
+            .iter()
+            .flatten()
+            .map(|v| v.view_proj.to_cols_array())
+            .collect();
+        let (cols, rows) = atlas_grid(matrices.len());
+        let (w, h) = match matrices.len() {
             0 => (1, 1),
             _ => (cols * resolution, rows * resolution),
         };
         let mut atlas = g.create_image("shadow atlas", ImageDesc::new(w, h, SHADOW_FORMAT));
         let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
-        let matrices: Vec<[f32; 16]> = views.iter().map(|v| v.view_proj.to_cols_array()).collect();
         g.simple_pass("shadow maps", &self.pipeline)
             .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
             .record(move |cx| {

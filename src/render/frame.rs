@@ -173,8 +173,6 @@ pub(super) struct Frame {
     /// one's shadow projection: the uniforms are made from them.
     lights: Vec<Light>,
     views: Vec<Option<ShadowView>>,
-    /// The shadowed lights' projections, in atlas tile order.
-    shadow_views: Vec<ShadowView>,
     shadow_resolution: u32,
     prefilter: PrefilterPass,
     debug: DebugPass,
@@ -318,7 +316,6 @@ impl Frame {
             shade: ShadePass::new(ctx, &inputs.variant)?,
             shadow: ShadowPass::new(ctx)?,
             visibility: VisibilityPass::new(ctx, &inputs.variant)?,
-            shadow_views: views.iter().flatten().copied().collect(),
             views,
             lights,
             shadow_resolution: scene.file.render.shadow_resolution,
@@ -413,12 +410,9 @@ impl Frame {
         if view == View::Prefiltered {
             return FrameImages::uv(self.prefilter.pass(g, &self.inputs.lighting_env, first));
         }
-        let shadows = self.shadow.pass(
-            g,
-            &self.inputs.mesh,
-            &self.shadow_views,
-            self.shadow_resolution,
-        );
+        let shadows = self
+            .shadow
+            .pass(g, &self.inputs.mesh, &self.views, self.shadow_resolution);
         let soft = self
             .visibility
             .pass(g, &self.inputs, &shadows, self.skin.resolution);

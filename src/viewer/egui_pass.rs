@@ -92,45 +92,43 @@ impl EguiPass {
             .flat_map(|(id, ds)| ds.iter().map(move |d| (id, d)))
         {
             let ImageData::Color(patch) = &d.image;
-            let texture = match (d.pos, self.textures.remove(id)) {
-                (Some([x0, y0]), Some(mut t)) => {
+            let (size, pixels) = match (d.pos, self.textures.remove(id)) {
+                (None, _) => (patch.size, patch.pixels.clone()),
+                (
+                    Some([x0, y0]),
+                    Some(Texture {
+                        size, mut pixels, ..
+                    }),
+                ) => {
                     for y in 0..patch.size[1] {
                         let row = &patch.pixels[y * patch.size[0]..(y + 1) * patch.size[0]];
-                        let start = (y0 + y) * t.size[0] + x0;
-                        t.pixels[start..start + row.len()].copy_from_slice(row);
+                        let start = (y0 + y) * size[0] + x0;
+                        pixels[start..start + row.len()].copy_from_slice(row);
                     }
-                    t
+                    (size, pixels)
                 }
-                (None, _) => Texture {
-                    size: patch.size,
-                    pixels: patch.pixels.clone(),
-                    image: self.dummy()?,
-                },
                 (Some(_), None) => {
                     return Err(Error::Graph(format!(
                         "egui patches {id:?} before setting it"
                     )));
                 }
             };
-            let desc = ImageDesc::new(
-                texture.size[0] as u32,
-                texture.size[1] as u32,
-                vk::Format::R8G8B8A8_UNORM,
-            );
-            let bytes: &[u8] = bytemuck::cast_slice(&texture.pixels);
+            let desc = ImageDesc::new(size[0] as u32, size[1] as u32, vk::Format::R8G8B8A8_UNORM);
+            let bytes: &[u8] = bytemuck::cast_slice(&pixels);
             let image = upload_texture(&self.ctx, &format!("egui {id:?}"), desc, bytes)?;
-            self.textures.insert(*id, Texture { image, ..texture });
+            self.textures.insert(
+                *id,
+                Texture {
+                    size,
+                    pixels,
+                    image,
+                },
+            );
         }
         for id in &delta.free {
             self.textures.remove(id);
         }
         Ok(())
-    }
-
-    /// A 1×1 white texture, the placeholder until a real one is uploaded.
-    fn dummy(&self) -> Result<Arc<Image>> {
-        let desc = ImageDesc::new(1, 1, vk::Format::R8G8B8A8_UNORM);
-        upload_texture(&self.ctx, "egui placeholder", desc, &[255; 4])
     }
 
     /// Draws `primitives` (egui's tessellation at `pixels_per_point`) over `target`.
