@@ -5,8 +5,8 @@
 
 use crate::error::Result;
 use crate::frame::{MeshBuffers, Vertex, SHADOW_FORMAT};
-use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
-use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::gpu::{Context, GraphicsDesc, Image, ImageDesc, Pipeline};
+use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use crate::scene::LightSource;
 use ash::vk;
 use glam::camera::rh::{proj::vulkan as proj, view::look_at_mat4};
@@ -108,12 +108,21 @@ impl ShadowView {
 }
 
 /// Renders the atlas: depth only, no culling (scanned meshes are not closed).
+/// The mesh and the lights do not move within a render, so the atlas is drawn by
+/// the first frame that needs it and kept.
 pub struct ShadowPass {
     pipeline: Arc<Pipeline>,
+    atlas: Arc<Image>,
+    /// The shadowed lights' projections, in tile order.
+    matrices: Vec<[f32; 16]>,
+    resolution: u32,
 }
 
 impl ShadowPass {
-    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+    /// The pass and atlas of the lights' `views` (`None`: unshadowed; the
+    /// shadowed ones take tiles in order), `resolution` texels a side; a 1×1
+    /// atlas when there are none, so the lighting shaders always have one to bind.
+    pub fn new(ctx: &Arc<Context>, views: &[Option<ShadowView>], resolution: u32) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -129,19 +138,6 @@ impl ShadowPass {
                 alpha_blend: false,
             },
         )?;
-        Ok(Self { pipeline })
-    }
-
-    /// The atlas of the lights' `views` (`None`: unshadowed; the shadowed ones
-    /// take tiles in order), `resolution` texels a side; a cleared 1×1 image
-    /// when there are none, so the lighting shaders always have one to bind.
-    pub fn pass(
-        &self,
-        g: &mut Graph,
-        mesh: &Arc<MeshBuffers>,
-        views: &[Option<ShadowView>],
-        resolution: u32,
-    ) -> ImageHandle {
         let matrices: Vec<[f32; 16]> = views
             .iter()
             .flatten()
@@ -152,18 +148,44 @@ impl ShadowPass {
             0 => (1, 1),
             _ => (cols * resolution, rows * resolution),
         };
-        let mut atlas = g.create_image("shadow atlas", ImageDesc::new(w, h, SHADOW_FORMAT));
-        let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
-        g.simple_pass("shadow maps", &self.pipeline)
-            .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
-            .record(move |cx| {
-                for (i, m) in matrices.iter().enumerate() {
-                    let (col, row) = (i as u32 % cols, i as u32 / cols);
-                    cx.set_viewport(col * resolution, row * resolution, resolution, resolution);
-                    cx.push_constants(&pipe, m);
-                    mesh.record_draw(cx);
-                }
-            });
+        let atlas = Image::new(
+            ctx,
+            "shadow atlas",
+            ImageDesc::new(w, h, SHADOW_FORMAT),
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+        )?;
+        Ok(Self {
+            pipeline,
+            atlas: Arc::new(atlas),
+            matrices,
+            resolution,
+        })
+    }
+
+    /// The atlas as a graph image; `draw`: the render's first frame that needs
+    /// it, which draws it (pass `shadow maps`); later frames import it as kept.
+    pub fn pass(&self, g: &mut Graph, mesh: &Arc<MeshBuffers>, draw: bool) -> ImageHandle {
+        let mut atlas = g.import_image(
+            "shadow atlas",
+            Imported::Image(self.atlas.clone()),
+            (!draw).then_some(Access::ShaderSampled),
+            Some(Access::ShaderSampled),
+        );
+        if draw {
+            let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
+            let (matrices, resolution) = (self.matrices.clone(), self.resolution);
+            let (cols, _) = atlas_grid(matrices.len());
+            g.simple_pass("shadow maps", &self.pipeline)
+                .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
+                .record(move |cx| {
+                    for (i, m) in matrices.iter().enumerate() {
+                        let (col, row) = (i as u32 % cols, i as u32 / cols);
+                        cx.set_viewport(col * resolution, row * resolution, resolution, resolution);
+                        cx.push_constants(&pipe, m);
+                        mesh.record_draw(cx);
+                    }
+                });
+        }
         atlas
     }
 }

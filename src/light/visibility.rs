@@ -8,8 +8,8 @@
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex};
-use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
-use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::gpu::{Context, GraphicsDesc, Image, ImageDesc, Pipeline};
+use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -28,10 +28,16 @@ pub struct VisibilityPass {
     pipeline: Arc<Pipeline>,
     /// Any light has an angular size and a shadow map.
     soft: bool,
+    /// Drawn by the render's first frame that needs them and kept, as the
+    /// shadow atlas they come from.
+    textures: Vec<Arc<Image>>,
 }
 
 impl VisibilityPass {
-    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
+    /// The pass and its textures at min(`resolution`/2, [`MAX_RESOLUTION`])² for
+    /// an irradiance texture of `resolution`²; 1×1 when no light is soft, so the
+    /// shading passes always have them to bind.
+    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant, resolution: u32) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -47,33 +53,47 @@ impl VisibilityPass {
                 alpha_blend: false,
             },
         )?;
+        let soft = variant.soft != 0;
+        let side = if soft {
+            (resolution / 2).clamp(1, MAX_RESOLUTION)
+        } else {
+            1
+        };
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let textures = (0..TEXTURES)
+            .map(|k| {
+                let desc = ImageDesc::new(side, side, FORMAT);
+                Image::new(ctx, &name(k), desc, usage).map(Arc::new)
+            })
+            .collect::<Result<_>>()?;
         Ok(Self {
             pipeline,
-            soft: variant.soft != 0,
+            soft,
+            textures,
         })
     }
 
-    /// The visibility textures at min(`resolution`/2, [`MAX_RESOLUTION`])², from the
-    /// lights' shadow `atlas` (light::shadow); three cleared 1×1 textures when no
-    /// light is soft, so the shading passes always have them to bind.
+    /// The visibility textures as graph images, from the lights' shadow `atlas`
+    /// (light::shadow); `draw`: the render's first frame that needs them, which
+    /// draws them (pass `light_visibility`).
     pub fn pass(
         &self,
         g: &mut Graph,
         inputs: &FrameInputs,
         atlas: &ImageHandle,
-        resolution: u32,
+        draw: bool,
     ) -> [ImageHandle; TEXTURES] {
-        let side = if self.soft {
-            (resolution / 2).clamp(1, MAX_RESOLUTION)
-        } else {
-            1
-        };
         let mut out: [ImageHandle; TEXTURES] = std::array::from_fn(|k| {
-            g.create_image(
-                &format!("soft visibility {k}"),
-                ImageDesc::new(side, side, FORMAT),
+            g.import_image(
+                &name(k),
+                Imported::Image(self.textures[k].clone()),
+                (!draw).then_some(Access::ShaderSampled),
+                Some(Access::ShaderSampled),
             )
         });
+        if !draw {
+            return out;
+        }
         let s = &inputs.samplers;
         let mut pass = g
             .simple_pass("light_visibility", &self.pipeline)
@@ -90,4 +110,8 @@ impl VisibilityPass {
         }
         out
     }
+}
+
+fn name(k: usize) -> String {
+    format!("soft visibility {k}")
 }

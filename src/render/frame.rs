@@ -173,7 +173,6 @@ pub(super) struct Frame {
     /// one's shadow projection: the uniforms are made from them.
     lights: Vec<Light>,
     views: Vec<Option<ShadowView>>,
-    shadow_resolution: u32,
     prefilter: PrefilterPass,
     debug: DebugPass,
     /// Where the depth view's 1 and 0 lie.
@@ -314,11 +313,10 @@ impl Frame {
             irradiance: IrradiancePass::new(ctx, &inputs.variant)?,
             blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
             shade: ShadePass::new(ctx, &inputs.variant)?,
-            shadow: ShadowPass::new(ctx)?,
-            visibility: VisibilityPass::new(ctx, &inputs.variant)?,
+            shadow: ShadowPass::new(ctx, &views, shadow_res)?,
+            visibility: VisibilityPass::new(ctx, &inputs.variant, res)?,
             views,
             lights,
-            shadow_resolution: scene.file.render.shadow_resolution,
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
             debug: DebugPass::new(ctx, &scene.regions)?,
             depth_range,
@@ -390,14 +388,14 @@ impl Frame {
     }
 
     /// Builds the frame graph for `view` at `(w, h)` (UV-space views: their
-    /// image as stored). `first`: the render's first frame (it also projects
-    /// the SH, prefilters the environment and computes the stretch maps).
+    /// image as stored). What `kept` says is not yet computed, and the view
+    /// needs, the frame computes, and marks it computed.
     pub(super) fn graph(
         &self,
         g: &mut Graph,
         view: View,
         (w, h): (u32, u32),
-        first: bool,
+        kept: &mut Kept,
     ) -> FrameImages {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let sh = self.sh.passes(
@@ -405,17 +403,18 @@ impl Frame {
             &self.inputs.lighting_env,
             &self.sh_buffers,
             Access::UniformRead,
-            first,
+            !std::mem::replace(&mut kept.sh, true),
         );
+        let mut prefiltered = |g: &mut Graph| {
+            let first = !std::mem::replace(&mut kept.prefiltered, true);
+            self.prefilter.pass(g, &self.inputs.lighting_env, first)
+        };
         if view == View::Prefiltered {
-            return FrameImages::uv(self.prefilter.pass(g, &self.inputs.lighting_env, first));
+            return FrameImages::uv(prefiltered(g));
         }
-        let shadows = self
-            .shadow
-            .pass(g, &self.inputs.mesh, &self.views, self.shadow_resolution);
-        let soft = self
-            .visibility
-            .pass(g, &self.inputs, &shadows, self.skin.resolution);
+        let draw = !std::mem::replace(&mut kept.shadows, true);
+        let shadows = self.shadow.pass(g, &self.inputs.mesh, draw);
+        let soft = self.visibility.pass(g, &self.inputs, &shadows, draw);
         let debug = match view {
             View::Depth => Some(DebugView::Depth),
             View::Normals => Some(DebugView::Normals),
@@ -438,6 +437,7 @@ impl Frame {
         } else {
             let res = self.skin.resolution;
             let mesh = &self.inputs.mesh;
+            let first = !std::mem::replace(&mut kept.stretch, true);
             let mut stretch = self.stretch.pass(g, mesh, &self.blur, first);
             let irradiance = self.irradiance.pass(
                 g,
@@ -469,7 +469,7 @@ impl Frame {
                     n => blurred.swap_remove(n - 1),
                 });
             }
-            let specular_env = self.prefilter.pass(g, &self.inputs.lighting_env, first);
+            let specular_env = prefiltered(g);
             self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
             let weights: Vec<_> = self
                 .skin
@@ -536,6 +536,21 @@ impl Frame {
             metered,
         }
     }
+}
+
+/// What a render computes once and keeps between its frames (the scene, the
+/// lights and the mesh do not change within it): each is computed by the first
+/// frame whose view needs it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Kept {
+    /// The environment's SH coefficients (light::sh_pass).
+    sh: bool,
+    /// The KS-prefiltered environment (light::prefilter).
+    prefiltered: bool,
+    /// The shadow atlas and the soft lights' visibility (light::shadow, light::visibility).
+    shadows: bool,
+    /// The stretch maps (skin::stretch).
+    stretch: bool,
 }
 
 /// The images a frame graph ends with.

@@ -25,7 +25,7 @@ use crate::scene::checker;
 use crate::scene::file::{Chain, Kernel, Occlusion};
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
-use frame::Frame;
+use frame::{Frame, Kept};
 use progress::Progress;
 use sheet::Sheet;
 use std::path::PathBuf;
@@ -265,7 +265,7 @@ fn run(
     let screen = (scene.file.render.width, scene.file.render.height);
     // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
     let (w, h) = {
-        let images = frame.graph(&mut Graph::new(), view, screen, true);
+        let images = frame.graph(&mut Graph::new(), view, screen, &mut Kept::default());
         (images.image.desc.width, images.image.desc.height)
     };
     let readback = |name: &str, bytes_per_texel: u64| {
@@ -289,9 +289,10 @@ fn run(
     let mut plan = String::new();
     let mut gpu_metered = false;
     let progress = Progress::new(opts.frames, opts.progress);
-    for i in 0..opts.frames {
+    let mut kept = Kept::default();
+    for _ in 0..opts.frames {
         let mut g = Graph::new();
-        let images = frame.graph(&mut g, view, screen, i == 0);
+        let images = frame.graph(&mut g, view, screen, &mut kept);
         if let (Some(ldr), Some(r)) = (&images.ldr, &ldr_readback) {
             r.image_pass(&mut g, ldr);
         }

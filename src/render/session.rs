@@ -3,7 +3,7 @@
 //! copied into an image of its own that another graph samples. Moving the camera
 //! only makes the frame's uniforms again; anything else is a new session.
 
-use super::frame::Frame;
+use super::frame::{Frame, Kept};
 use super::{check_target, settings, View};
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc};
@@ -20,9 +20,9 @@ pub struct Session {
     scene: Scene,
     frame: Frame,
     executor: Executor,
-    /// The next frame is the session's first (it also computes what is kept:
-    /// stretch maps, SH, the prefiltered environment).
-    first: bool,
+    /// What the session's frames have computed and keep (stretch maps, SH,
+    /// the prefiltered environment, shadows).
+    kept: Kept,
 }
 
 impl Session {
@@ -35,7 +35,7 @@ impl Session {
             executor: Executor::new(ctx, 1)?,
             scene,
             frame,
-            first: true,
+            kept: Kept::default(),
         })
     }
 
@@ -69,7 +69,9 @@ impl Session {
     pub fn render(&mut self, view: View) -> Result<(Arc<Image>, Option<FrameReport>)> {
         let size = (self.scene.file.render.width, self.scene.file.render.height);
         let mut g = Graph::new();
-        let images = self.frame.graph(&mut g, view, size, self.first);
+        // Marked kept once the frame has been submitted.
+        let mut kept = self.kept;
+        let images = self.frame.graph(&mut g, view, size, &mut kept);
         let ldr = match images.ldr {
             Some(ldr) => ldr,
             None => self.frame.encode(&mut g, images.image, view),
@@ -79,7 +81,10 @@ impl Session {
             &self.ctx,
             "viewer frame",
             ImageDesc::new(w, h, ldr.desc.format),
-            vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED,
+            // TRANSFER_SRC: it can be read back (tests/session.rs).
+            vk::ImageUsageFlags::TRANSFER_DST
+                | vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_SRC,
         )?);
         let mut out = g.import_image(
             "viewer frame",
@@ -100,7 +105,7 @@ impl Session {
             .into_iter()
             .collect::<Vec<_>>();
         reports.extend(self.executor.finish()?);
-        self.first = false;
+        self.kept = kept;
         Ok((image, reports.pop()))
     }
 }

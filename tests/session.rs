@@ -1,0 +1,61 @@
+//! A lasting render (the viewer's `render::session`): what a session computes once
+//! and keeps (SH, stretch maps, the prefiltered environment, the shadow atlas and
+//! soft visibility) is computed by the first frame that needs it, whatever view
+//! came first, and frames that reuse it are the frames that computed it.
+
+mod common;
+
+use dermis::gpu::{Context, Image};
+use dermis::graph::upload::Readback;
+use dermis::graph::{Access, Executor, Graph, Imported};
+use dermis::render::session::Session;
+use dermis::render::View;
+use dermis::scene::file::load_scene;
+use dermis::scene::Scene;
+use std::sync::Arc;
+
+/// The RGBA8 pixels of a session's displayable image.
+fn pixels(ctx: &Arc<Context>, image: &Arc<Image>) -> Vec<u8> {
+    let (w, h) = (image.desc.width as u64, image.desc.height as u64);
+    let readback = Readback::new(ctx, "readback", w * h * 4).unwrap();
+    let mut g = Graph::new();
+    let handle = g.import_image(
+        "session image",
+        Imported::Image(image.clone()),
+        Some(Access::FragmentSampled),
+        Some(Access::FragmentSampled),
+    );
+    readback.image_pass(&mut g, &handle);
+    let mut executor = Executor::new(ctx, 1).unwrap();
+    let compiled = executor.compile(g).unwrap();
+    executor.submit(compiled).unwrap();
+    executor.finish().unwrap();
+    readback.bytes().unwrap().to_vec()
+}
+
+#[test]
+fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
+    // The scan under royal_esplanade: two extracted lamps, soft-shadowed.
+    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
+    file.render.width = 64;
+    file.render.height = 80;
+    file.render.irradiance_resolution = 256;
+    let scene = Scene::load(file).unwrap();
+    common::with_gpu(|ctx| {
+        let mut fresh = Session::new(ctx, scene.clone()).unwrap();
+        assert!(fresh.extracted_lights() > 0);
+        let (first, _) = fresh.render(View::Final).unwrap();
+        let expected = pixels(ctx, &first);
+        // The next frame reuses all that is kept: the same image.
+        let (again, _) = fresh.render(View::Final).unwrap();
+        assert_eq!(pixels(ctx, &again), expected, "a frame on what was kept");
+        // Views that skip the chain, the prefilter, or the shadows and the
+        // chain; then the full frame computes what they skipped.
+        for view in [View::Depth, View::Direct, View::Irradiance, View::Prefiltered] {
+            let mut session = Session::new(ctx, scene.clone()).unwrap();
+            session.render(view).unwrap();
+            let (image, _) = session.render(View::Final).unwrap();
+            assert_eq!(pixels(ctx, &image), expected, "final after {}", view.name());
+        }
+    });
+}
