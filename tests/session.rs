@@ -51,7 +51,12 @@ fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
         assert_eq!(pixels(ctx, &again), expected, "a frame on what was kept");
         // Views that skip the chain, the prefilter, or the shadows and the
         // chain; then the full frame computes what they skipped.
-        for view in [View::Depth, View::Direct, View::Irradiance, View::Prefiltered] {
+        for view in [
+            View::Depth,
+            View::Direct,
+            View::Irradiance,
+            View::Prefiltered,
+        ] {
             let mut session = Session::new(ctx, scene.clone()).unwrap();
             session.render(view).unwrap();
             let (image, _) = session.render(View::Final).unwrap();

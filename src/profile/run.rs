@@ -1,7 +1,7 @@
 //! What `--report FILE.json` writes: what was run, where, and what it cost.
 
 use super::stats::Stats;
-use super::FrameReport;
+use super::{FrameReport, PassTime};
 use crate::gpu::DeviceInfo;
 use serde::{Deserialize, Serialize};
 
@@ -145,6 +145,9 @@ pub struct RunReport {
     pub frame_span: PassStats,
     /// Per-pass medians over the measured frames.
     pub median: Option<FrameReport>,
+    /// Passes only the warm-up frame ran: what a render computes once and keeps
+    /// (SH projection, prefiltered environment, stretch maps, shadows).
+    pub warmup_only: Vec<PassTime>,
     pub per_frame: Vec<FrameReport>,
 }
 
@@ -183,6 +186,12 @@ impl RunReport {
             p.x_ruler = p.ns_per_texel.zip(ruler).map(|(a, r)| a / r);
         }
         let spans = measured.iter().filter_map(|f| f.gpu_frame_ns).collect();
+        let warmup_only = per_frame[..warmup]
+            .iter()
+            .flat_map(|f| &f.passes)
+            .filter(|p| !names.contains(&p.name.as_str()))
+            .cloned()
+            .collect();
         Self {
             dermis_version: VERSION.into(),
             git_commit: GIT_COMMIT.into(),
@@ -204,6 +213,7 @@ impl RunReport {
             passes,
             frame_span: PassStats::of("frame (GPU span)", spans),
             median: FrameReport::median(measured),
+            warmup_only,
             per_frame,
         }
     }
@@ -315,6 +325,17 @@ impl RunReport {
             s += &row(name, v.len(), Stats::of(&v));
             s.push('\n');
         }
+        if !self.warmup_only.is_empty() {
+            let once: Vec<String> = self
+                .warmup_only
+                .iter()
+                .map(|p| format!("{} {}", p.name, ms(p.gpu_ns)))
+                .collect();
+            s += &format!(
+                "once per render (warm-up frame only, ms): {}\n",
+                once.join(", ")
+            );
+        }
         let dropped: u32 = measured.iter().map(|f| f.dropped_deltas).sum();
         if dropped > 0 {
             s += &format!("({dropped} non-positive timestamp deltas dropped)\n");
@@ -333,7 +354,6 @@ impl RunReport {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::profile::PassTime;
 
     /// Frames of passes "a" (at 10 ns, lasting `a`) and "b" (right after),
     /// on the host-fence clock, 1000 ns apart.
@@ -432,6 +452,25 @@ pub(super) mod tests {
         let table = r.table();
         assert!(
             table.contains("p90") && table.contains("frame (GPU span)"),
+            "{table}"
+        );
+        assert!(r.warmup_only.is_empty() && !table.contains("once per render"));
+    }
+
+    #[test]
+    fn passes_only_the_warm_up_ran_are_listed_apart() {
+        let mut f = frames(&[1000.0, 40.0, 10.0]);
+        f[0].passes.push(PassTime {
+            name: "shadow maps".into(),
+            gpu_ns: Some(2.5e6),
+            ..Default::default()
+        });
+        let r = RunReport::new(&device(), setup(), 64, 48, f, MemoryUse::default());
+        assert_eq!(r.passes.len(), 2);
+        assert_eq!(r.warmup_only.len(), 1);
+        let table = r.table();
+        assert!(
+            table.contains("once per render (warm-up frame only, ms): shadow maps 2.500"),
             "{table}"
         );
     }
