@@ -107,6 +107,15 @@ impl ShadowView {
     }
 }
 
+/// The shadowed lights' projections, in tile order.
+fn tile_matrices(views: &[Option<ShadowView>]) -> Vec<[f32; 16]> {
+    views
+        .iter()
+        .flatten()
+        .map(|v| v.view_proj.to_cols_array())
+        .collect()
+}
+
 /// Renders the atlas: depth only, no culling (scanned meshes are not closed).
 /// The mesh and the lights do not move within a render, so the atlas is drawn by
 /// the first frame that needs it and kept.
@@ -138,11 +147,7 @@ impl ShadowPass {
                 alpha_blend: false,
             },
         )?;
-        let matrices: Vec<[f32; 16]> = views
-            .iter()
-            .flatten()
-            .map(|v| v.view_proj.to_cols_array())
-            .collect();
+        let matrices = tile_matrices(views);
         let (cols, rows) = atlas_grid(matrices.len());
         let (w, h) = match matrices.len() {
             0 => (1, 1),
@@ -160,6 +165,14 @@ impl ShadowPass {
             matrices,
             resolution,
         })
+    }
+
+    /// The same lights turned (the environment's sources): new projections, as
+    /// many tiles.
+    pub fn set_views(&mut self, views: &[Option<ShadowView>]) {
+        let matrices = tile_matrices(views);
+        debug_assert_eq!(matrices.len(), self.matrices.len(), "the atlas's tiles");
+        self.matrices = matrices;
     }
 
     /// The atlas as a graph image; `draw`: the render's first frame that needs

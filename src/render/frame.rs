@@ -190,8 +190,8 @@ pub(super) struct Frame {
     /// render.skybox: draw the environment behind the head.
     skybox_on: bool,
     pub(super) post: PostSettings,
-    /// Bright sources taken out of the environment as lights.
-    pub(super) extracted_lights: usize,
+    /// Bright sources taken out of the environment as lights (in the map's frame).
+    pub(super) extracted: Vec<ExtractedLight>,
 }
 
 impl Frame {
@@ -340,7 +340,7 @@ impl Frame {
             },
             skybox_on: scene.file.render.skybox,
             post: PostSettings::resolve(&scene.file.render),
-            extracted_lights: extraction.lights.len(),
+            extracted: extraction.lights,
         })
     }
 
@@ -356,6 +356,30 @@ impl Frame {
             Access::UniformRead,
         )?;
         Ok(())
+    }
+
+    /// Turns the environment to `scene.file.environment.rotation_deg`: the SH
+    /// transform, the extracted sources' directions, their shadow projections
+    /// and the uniforms are made again. What `kept` holds of them (the SH, the
+    /// shadows) is to be computed again.
+    pub(super) fn set_rotation(
+        &mut self,
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        kept: &mut Kept,
+    ) -> Result<()> {
+        let env = &scene.file.environment;
+        self.sh_buffers = ShBuffers::new(
+            ctx,
+            &self.inputs.lighting_env,
+            env.rotation_deg,
+            env.intensity,
+        )?;
+        self.lights = frame_lights(scene, &self.extracted);
+        self.views = shadow_views(scene, &self.lights);
+        self.shadow.set_views(&self.views);
+        (kept.sh, kept.shadows) = (false, false);
+        self.set_camera(ctx, scene)
     }
 
     /// The post-processing settings (exposure, tone curve, glow, background)

@@ -346,7 +346,7 @@ fn run(
         scene,
         opts,
         view,
-        frame.extracted_lights,
+        frame.extracted.len(),
         (ev, metered.is_some()),
     );
     let report = RunReport::new(&ctx.info, run_setup, w, h, reports, memory);

@@ -45,7 +45,18 @@ impl Session {
 
     /// Bright sources the session's frames light with (`environment.lights`).
     pub fn extracted_lights(&self) -> usize {
-        self.frame.extracted_lights
+        self.frame.extracted.len()
+    }
+
+    /// Turns the environment (`environment.rotation_deg`) without a new session:
+    /// its SH are rotated, its extracted sources turned with their shadows.
+    pub fn set_rotation(&mut self, rotation_deg: f32) -> Result<()> {
+        if self.scene.file.environment.rotation_deg == rotation_deg {
+            return Ok(());
+        }
+        self.scene.file.environment.rotation_deg = rotation_deg;
+        self.frame
+            .set_rotation(&self.ctx, &self.scene, &mut self.kept)
     }
 
     /// Replaces the post-processing settings (`render`'s exposure, tone curve,

@@ -1,8 +1,9 @@
 //! The viewer's render thread: frames of the skin pipeline are rendered here, on
 //! demand, while the window thread keeps presenting the last one and the UI at
 //! display rate. Jobs queue up and only the newest is rendered; a job whose
-//! settings differ from the session's in more than the camera and size starts a
-//! new session (scene loaded again, pipelines built again).
+//! settings differ from the session's in more than the camera, the size, the
+//! environment's rotation and the post-processing starts a new session (scene
+//! loaded again, pipelines built again).
 
 use crate::error::Result;
 use crate::gpu::{Context, Image};
@@ -152,18 +153,20 @@ fn render(
     }
     let (_, s) = session.as_mut().expect("made above");
     s.set_post(&file.render);
+    s.set_rotation(file.environment.rotation_deg)?;
     s.set_camera(job.camera, job.size)?;
     let (image, report) = s.render(job.view)?;
     Ok((image, report, s.extracted_lights(), rebuilt))
 }
 
 /// The settings that need a new session when they change: all but the camera,
-/// the size and the post-processing (exposure, tone curve, glow, background),
-/// which a session takes as they come.
+/// the size, the environment's rotation and the post-processing (exposure, tone
+/// curve, glow, background), which a session takes as they come.
 fn session_settings(file: &SceneFile) -> SceneFile {
     let mut f = file.clone();
     let default = SceneFile::default();
     f.camera = default.camera;
+    f.environment.rotation_deg = default.environment.rotation_deg;
     let r = &mut f.render;
     (r.width, r.height) = (0, 0);
     (
