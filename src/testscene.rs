@@ -42,20 +42,7 @@ pub const HALF: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 impl TestScene {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
         let composite = |format| {
-            Pipeline::graphics(
-                ctx,
-                &GraphicsDesc {
-                    vertex: "fullscreen.vert",
-                    fragment: "composite.frag",
-                    color_formats: &[format],
-                    depth_format: None,
-                    depth_write: true,
-                    vertex_layout: None,
-                    cull_mode: vk::CullModeFlags::NONE,
-                    specialization: &[],
-                    alpha_blend: false,
-                },
-            )
+            Pipeline::graphics(ctx, &GraphicsDesc::fullscreen("composite.frag", &[format]))
         };
         Ok(Self {
             pattern: Pipeline::compute(ctx, "pattern.comp")?,

@@ -26,6 +26,24 @@ pub struct GraphicsDesc<'a> {
     pub alpha_blend: bool,
 }
 
+impl<'a> GraphicsDesc<'a> {
+    /// A full-screen triangle (shaders-glsl/fullscreen.vert, no vertex input)
+    /// shading `fragment` into one colour target of each of `color_formats`.
+    pub fn fullscreen(fragment: &'a str, color_formats: &'a [vk::Format]) -> Self {
+        Self {
+            vertex: "fullscreen.vert",
+            fragment,
+            color_formats,
+            depth_format: None,
+            depth_write: false,
+            vertex_layout: None,
+            cull_mode: vk::CullModeFlags::NONE,
+            specialization: &[],
+            alpha_blend: false,
+        }
+    }
+}
+
 /// Map entries for specialization constants 0..n, one 32-bit word each.
 fn specialization_entries(values: &[u32]) -> Vec<vk::SpecializationMapEntry> {
     (0..values.len() as u32)

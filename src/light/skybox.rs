@@ -4,7 +4,6 @@ use crate::error::Result;
 use crate::frame::{FrameInputs, HDR_FORMAT};
 use crate::gpu::{Context, GraphicsDesc, Pipeline};
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};
-use ash::vk;
 use std::sync::Arc;
 
 pub struct SkyboxPass {
@@ -15,17 +14,7 @@ impl SkyboxPass {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
-            &GraphicsDesc {
-                vertex: "fullscreen.vert",
-                fragment: "background.frag",
-                color_formats: &[HDR_FORMAT],
-                depth_format: None,
-                depth_write: true,
-                vertex_layout: None,
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &[],
-                alpha_blend: false,
-            },
+            &GraphicsDesc::fullscreen("background.frag", &[HDR_FORMAT]),
         )?;
         Ok(Self { pipeline })
     }

@@ -18,7 +18,6 @@ use crate::error::Result;
 use crate::frame::HDR_FORMAT;
 use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
 use crate::graph::{Graph, ImageHandle, LoadOp};
-use ash::vk;
 use std::sync::Arc;
 
 /// (weight, variance in image heights²) of each Gaussian.
@@ -84,17 +83,7 @@ impl Glow {
             blur: Pipeline::compute(ctx, "glow_blur.comp")?,
             composite: Pipeline::graphics(
                 ctx,
-                &GraphicsDesc {
-                    vertex: "fullscreen.vert",
-                    fragment: "glow.frag",
-                    color_formats: &[HDR_FORMAT],
-                    depth_format: None,
-                    depth_write: true,
-                    vertex_layout: None,
-                    cull_mode: vk::CullModeFlags::NONE,
-                    specialization: &[],
-                    alpha_blend: false,
-                },
+                &GraphicsDesc::fullscreen("glow.frag", &[HDR_FORMAT]),
             )?,
             nearest,
             linear,

@@ -114,17 +114,7 @@ impl Tonemap {
     pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
-            &GraphicsDesc {
-                vertex: "fullscreen.vert",
-                fragment: "tonemap.frag",
-                color_formats: &[LDR_FORMAT],
-                depth_format: None,
-                depth_write: true,
-                vertex_layout: None,
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &[],
-                alpha_blend: false,
-            },
+            &GraphicsDesc::fullscreen("tonemap.frag", &[LDR_FORMAT]),
         )?;
         Ok(Self { pipeline, sampler })
     }

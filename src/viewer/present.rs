@@ -48,17 +48,7 @@ impl Presenter {
         let swapchain = Swapchain::new(ctx, &surface, size, None)?;
         let present = Pipeline::graphics(
             ctx,
-            &GraphicsDesc {
-                vertex: "fullscreen.vert",
-                fragment: "present.frag",
-                color_formats: &[swapchain.format],
-                depth_format: None,
-                depth_write: false,
-                vertex_layout: None,
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &[],
-                alpha_blend: false,
-            },
+            &GraphicsDesc::fullscreen("present.frag", &[swapchain.format]),
         )?;
         let placeholder = upload_texture(
             ctx,
