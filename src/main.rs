@@ -215,7 +215,8 @@ enum Command {
         /// Side of the UV-space irradiance texture, replacing the scene's.
         #[arg(long)]
         irradiance_res: Option<u32>,
-        /// Window width in pixels (default: the scene's render width).
+        /// Window width in pixels (default: the scene's render width plus the
+        /// panel's, 360).
         #[arg(long)]
         width: Option<u32>,
         /// Window height in pixels (default: the scene's render height).

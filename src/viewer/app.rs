@@ -87,11 +87,17 @@ impl App {
 
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Open> {
         let r = &self.opts.scene.render;
+        // The scene's framing beside the panel, unless the command line gave a width.
+        let width = self
+            .opts
+            .overrides
+            .width
+            .unwrap_or(r.width + ui::PANEL_WIDTH);
         let window = event_loop
             .create_window(
                 Window::default_attributes()
                     .with_title("dermis")
-                    .with_inner_size(PhysicalSize::new(r.width, r.height)),
+                    .with_inner_size(PhysicalSize::new(width, r.height)),
             )
             .map_err(|e| Error::Window(format!("cannot open a window: {e}")))?;
         let window = Arc::new(window);

@@ -14,6 +14,9 @@ use std::collections::VecDeque;
 
 /// Frames the timings are the median of, and the graph shows.
 pub const HISTORY: usize = 120;
+/// Room the panel takes beside the image, in pixels at scale 1 (its content is
+/// wider than its default width of 270 points).
+pub const PANEL_WIDTH: u32 = 360;
 
 /// What the controls edit.
 #[derive(Clone, Debug, PartialEq)]
