@@ -70,6 +70,8 @@ pub struct Context {
     pub device: ash::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
     queue: Mutex<vk::Queue>,
+    /// Held by work that must not wait behind another thread's (see [`Context::foreground`]).
+    foreground: Mutex<()>,
     pub queue_family: u32,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     pub info: DeviceInfo,
@@ -188,6 +190,7 @@ impl Context {
             device,
             push_descriptor,
             queue: Mutex::new(queue),
+            foreground: Mutex::new(()),
             queue_family,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             info,
@@ -214,6 +217,15 @@ impl Context {
 
     pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
         self.queue.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Held by a thread while its submissions must not queue behind another
+    /// thread's (the viewer's window frames, from submit to present): background
+    /// executors (`graph::Executor::set_background`) wait for it before each
+    /// submission. The device has one queue, and on a CPU device a submission
+    /// runs after everything submitted before it.
+    pub fn foreground(&self) -> MutexGuard<'_, ()> {
+        self.foreground.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// Names a Vulkan object for debuggers and validation messages.

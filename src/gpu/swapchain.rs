@@ -230,7 +230,11 @@ impl Swapchain {
 impl Drop for Swapchain {
     fn drop(&mut self) {
         // Presents and frames that use the semaphores and images must be over.
-        let _ = unsafe { self.ctx.device.device_wait_idle() };
+        // vkDeviceWaitIdle needs the queue to itself (external synchronisation).
+        {
+            let _queue = self.ctx.queue();
+            let _ = unsafe { self.ctx.device.device_wait_idle() };
+        }
         self.images.clear();
         unsafe {
             for &s in self.ready.iter().chain(&self.rendered) {

@@ -83,6 +83,8 @@ pub struct Executor {
     /// timestamp (GPU clock) and an instant (host clock).
     gpu_epoch: Option<u64>,
     host_epoch: Option<Instant>,
+    /// Submissions wait while another thread holds `Context::foreground`.
+    background: bool,
 }
 
 impl Executor {
@@ -98,12 +100,20 @@ impl Executor {
             pool_images: Vec::new(),
             gpu_epoch: None,
             host_epoch: None,
+            background: false,
         };
         for _ in 0..frames_in_flight.max(1) {
             let slot = ex.new_slot()?;
             ex.slots.push(slot);
         }
         Ok(ex)
+    }
+
+    /// Makes every submission wait while another thread holds
+    /// [`Context::foreground`](crate::gpu::Context::foreground) (with one
+    /// submission per pass on CPU devices, between passes).
+    pub fn set_background(&mut self) {
+        self.background = true;
     }
 
     /// Overrides the automatic choice; `GpuTimestamp` needs device timestamps.
@@ -255,6 +265,9 @@ impl Executor {
             .command_buffer_infos(&cmd_info)
             .wait_semaphore_infos(&waits)
             .signal_semaphore_infos(&signals)];
+        if self.background {
+            drop(self.ctx.foreground());
+        }
         let queue = self.ctx.queue();
         unsafe { self.ctx.device.queue_submit2(*queue, &submit, slot.fence) }.vk("vkQueueSubmit2")
     }

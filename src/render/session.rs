@@ -30,9 +30,12 @@ impl Session {
     pub fn new(ctx: &Arc<Context>, scene: Scene) -> Result<Self> {
         let skin = settings(ctx, &scene)?;
         let frame = Frame::new(ctx, &scene, &scene.albedo, skin, false)?;
+        // Its passes wait for a window frame in progress (gpu::Context::foreground).
+        let mut executor = Executor::new(ctx, 1)?;
+        executor.set_background();
         Ok(Self {
             ctx: ctx.clone(),
-            executor: Executor::new(ctx, 1)?,
+            executor,
             scene,
             frame,
             kept: Kept::default(),

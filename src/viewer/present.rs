@@ -152,6 +152,10 @@ impl Presenter {
             None => None,
         };
         let compiled = self.executor.compile(g)?;
+        // No pass of the render thread's is submitted between this frame's
+        // submission and its present (lavapipe's present waits for the queue).
+        let ctx = self.ctx.clone();
+        let foreground = ctx.foreground();
         let report = self.executor.submit_synced(
             compiled,
             FrameSync {
@@ -162,6 +166,7 @@ impl Presenter {
         if !self.swapchain.present(index, rendered)? {
             self.recreate()?;
         }
+        drop(foreground);
         if let (Some(path), Some(r)) = (screenshot, readback) {
             self.executor.finish()?;
             save_png(path, r.bytes()?, (w, h), self.swapchain.format)?;
