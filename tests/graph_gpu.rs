@@ -1,5 +1,6 @@
 //! The render graph on a real device: upload → clear → compute blur (two passes)
-//! → graphics pass → readback, checked texel by texel against a CPU computation.
+//! → graphics pass → readback, checked texel by texel against a CPU computation;
+//! and the foreground gate background executors wait for.
 
 mod common;
 
@@ -282,5 +283,34 @@ fn simple_pass_declarations_are_checked_against_the_shader() {
         })
         .expect("missing bindings are checked");
         assert!(missing.contains("declares 0 bindings"), "{missing}");
+    });
+}
+
+#[test]
+fn a_background_executor_does_not_submit_while_the_foreground_is_held() {
+    let input = common::pattern(W * H * 4, 3);
+    common::with_gpu(|ctx| {
+        let c = chain(ctx, &input);
+        let mut ex = Executor::new(ctx, 1).unwrap();
+        ex.set_background();
+        let compiled = build(&mut ex, &c);
+        let submitted = std::sync::atomic::AtomicBool::new(false);
+        std::thread::scope(|s| {
+            let foreground = ctx.foreground();
+            let worker = s.spawn(|| {
+                ex.submit(compiled).unwrap();
+                ex.finish().unwrap();
+                submitted.store(true, std::sync::atomic::Ordering::SeqCst);
+            });
+            // Ample time for an unblocked submission of this tiny graph.
+            std::thread::sleep(std::time::Duration::from_millis(300));
+            assert!(
+                !submitted.load(std::sync::atomic::Ordering::SeqCst),
+                "submitted while the foreground was held"
+            );
+            drop(foreground);
+            worker.join().unwrap();
+        });
+        assert!(submitted.into_inner());
     });
 }
