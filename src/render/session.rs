@@ -1,7 +1,8 @@
 //! A render that lasts (the viewer's): the scene uploaded and the frame's
 //! pipelines built once, then frames on demand, each encoded for display and
 //! copied into an image of its own that another graph samples. Moving the camera
-//! only makes the frame's uniforms again; anything else is a new session.
+//! only makes the frame's uniforms again, turning the environment also its SH
+//! and the lights' shadows; anything else is a new session.
 
 use super::frame::{Frame, Kept};
 use super::{check_target, settings, View};
