@@ -105,3 +105,68 @@ fn turning_the_environment_in_a_session_is_a_fresh_session_at_that_angle() {
         );
     });
 }
+
+#[test]
+fn a_session_shows_uv_views_as_render_writes_them() {
+    // The scan's maps have their UV origin at the bottom left: both paths flip
+    // its UV-space views (tests/views.rs checks render's against the UVs).
+    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
+    file.render.width = 64;
+    file.render.height = 80;
+    file.render.irradiance_resolution = 256;
+    let scene = Scene::load(file).unwrap();
+    let (shown, written) = common::with_gpu(|ctx| {
+        let mut session = Session::new(ctx, scene.clone()).unwrap();
+        let (image, _) = session.render(View::Irradiance).unwrap();
+        let opts = dermis::render::RenderOptions {
+            view: View::Irradiance,
+            ..Default::default()
+        };
+        let out = dermis::render::render_scene(ctx, &scene, &opts).unwrap();
+        (pixels(ctx, &image), out.rgba8)
+    });
+    let mut upside_down = written.clone();
+    dermis::scene::texture::flip_rows(&mut upside_down, 256 * 4);
+    let mean = |a: &[u8], b: &[u8]| {
+        let rgb = |i: usize| i % 4 != 3;
+        let (sum, n) = a
+            .iter()
+            .zip(b)
+            .enumerate()
+            .filter(|(i, _)| rgb(*i))
+            .fold((0.0, 0.0), |(s, n), (_, (&x, &y))| {
+                (s + (x as f64 - y as f64).abs(), n + 1.0)
+            });
+        sum / n
+    };
+    let (same, flipped) = (mean(&shown, &written), mean(&shown, &upside_down));
+    println!(
+        "mean |session - render|: {same:.3} 8-bit steps; against render flipped: {flipped:.3}"
+    );
+    // The session meters and encodes on the GPU, render on the CPU: the same
+    // functions (tests/tonemap.rs), at most rounding apart.
+    assert!(same < 0.5 && flipped > 20.0, "{same} {flipped}");
+}
+
+#[test]
+fn a_session_meters_the_frame_at_its_new_size() {
+    // The window grew: the frame is metered over all of its pixels.
+    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
+    file.render.width = 48;
+    file.render.height = 60;
+    file.render.irradiance_resolution = 256;
+    let small = Scene::load(file).unwrap();
+    let mut large = small.clone();
+    (large.file.render.width, large.file.render.height) = (96, 120);
+    common::with_gpu(|ctx| {
+        let mut fresh = Session::new(ctx, large.clone()).unwrap();
+        let (image, _) = fresh.render(View::Final).unwrap();
+        let expected = pixels(ctx, &image);
+        let mut session = Session::new(ctx, small.clone()).unwrap();
+        session.render(View::Final).unwrap();
+        let camera = session.scene().camera;
+        session.set_camera(camera, (96, 120)).unwrap();
+        let (image, _) = session.render(View::Final).unwrap();
+        assert_eq!(differing(&pixels(ctx, &image), &expected), 0);
+    });
+}

@@ -25,7 +25,7 @@ fn tonemap(ramp: &[f32], exposure: Exposure, display: &Display) -> (Vec<u8>, Opt
         let src = upload_texture(ctx, "ramp", desc, &common::to_f16_bytes(ramp)).unwrap();
         let sampler = Arc::new(Sampler::clamped(ctx, false).unwrap());
         let tonemap = Tonemap::new(ctx, sampler.clone()).unwrap();
-        let meter = Meter::new(ctx, (W, 1), sampler).unwrap();
+        let meter = Meter::new(ctx, sampler).unwrap();
         let readback = Readback::new(ctx, "ldr", W as u64 * 4).unwrap();
         let metered = Readback::new(ctx, "exposure", meter::RESULT_BYTES).unwrap();
         let mut g = Graph::new();

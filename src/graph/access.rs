@@ -23,7 +23,9 @@ pub enum Access {
     ColorAttachment,
     /// Depth attachment (test and write).
     DepthAttachment,
+    /// Read by a copy or a blit.
     TransferSrc,
+    /// Written by a copy, a blit or a clear.
     TransferDst,
     /// Blits within one image (mip generation); leaves it in TRANSFER_DST_OPTIMAL.
     Blit,
@@ -113,9 +115,14 @@ impl Access {
                 L::DEPTH_ATTACHMENT_OPTIMAL,
                 true,
             ),
-            Access::TransferSrc => (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL, false),
+            Access::TransferSrc => (
+                S::COPY | S::BLIT,
+                A::TRANSFER_READ,
+                L::TRANSFER_SRC_OPTIMAL,
+                false,
+            ),
             Access::TransferDst => (
-                S::COPY | S::CLEAR,
+                S::COPY | S::BLIT | S::CLEAR,
                 A::TRANSFER_WRITE,
                 L::TRANSFER_DST_OPTIMAL,
                 true,

@@ -285,6 +285,36 @@ impl<'a> PassCx<'a> {
         };
     }
 
+    /// Copies `src` into `dst` (same size and format) with its rows in reverse
+    /// order: a blit from the bottom row up.
+    pub fn copy_image_flipped(&self, src: ImageRef, dst: ImageRef) {
+        let (s, d) = (self.image(src), self.image(dst));
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let (w, h) = (s.desc.width as i32, s.desc.height as i32);
+        let region = vk::ImageBlit2::default()
+            .src_subresource(layers)
+            .src_offsets([
+                vk::Offset3D { x: 0, y: h, z: 0 },
+                vk::Offset3D { x: w, y: 0, z: 1 },
+            ])
+            .dst_subresource(layers)
+            .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }]);
+        let regions = [region];
+        let blit = vk::BlitImageInfo2::default()
+            .src_image(s.raw)
+            .src_image_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .dst_image(d.raw)
+            .dst_image_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .regions(&regions)
+            .filter(vk::Filter::NEAREST);
+        unsafe { self.device().cmd_blit_image2(self.cmd, &blit) };
+    }
+
     pub fn copy_image_to_buffer(&self, image: ImageRef, buffer: BufferRef) {
         self.copy_level_to_buffer(image, 0, buffer);
     }

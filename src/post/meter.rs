@@ -101,18 +101,20 @@ pub struct Meter {
     partials: Arc<Buffer>,
     /// [`RESULT_BYTES`]: what the tone map reads.
     result: Arc<Buffer>,
-    tiles_xy: [u32; 2],
+}
+
+/// Tiles of an image of `width` × `height`.
+fn tiles_of(width: u32, height: u32) -> [u32; 2] {
+    [width.div_ceil(TILE), height.div_ceil(TILE)]
 }
 
 impl Meter {
-    /// For frames of `width` × `height`.
-    pub fn new(
-        ctx: &Arc<Context>,
-        (width, height): (u32, u32),
-        sampler: Arc<Sampler>,
-    ) -> Result<Self> {
-        let tiles_xy = [width.div_ceil(TILE), height.div_ceil(TILE)];
-        let tile_count = tiles_xy[0] * tiles_xy[1];
+    /// For images of any size the device allows: a screen view at any window
+    /// size, a UV-space view at its own resolution (the viewer meters both).
+    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+        let max = ctx.info.max_image_dimension_2d;
+        let [x, y] = tiles_of(max, max);
+        let tile_count = u64::from(x) * u64::from(y);
         let buffer = |name: &str, size: u64, extra| {
             Buffer::new(
                 ctx,
@@ -129,11 +131,10 @@ impl Meter {
             sampler,
             partials: buffer(
                 "meter partials",
-                tile_count as u64 * 8,
+                tile_count * 8,
                 vk::BufferUsageFlags::empty(),
             )?,
             result: buffer("exposure", RESULT_BYTES, vk::BufferUsageFlags::TRANSFER_SRC)?,
-            tiles_xy,
         })
     }
 
@@ -150,6 +151,7 @@ impl Meter {
 
     /// Meters `hdr` (passes `meter`, `meter_reduce`); returns the result, written.
     pub fn pass(&self, g: &mut Graph, hdr: &ImageHandle) -> BufferHandle {
+        let tiles_xy = tiles_of(hdr.desc.width, hdr.desc.height);
         let mut result = self.result(g);
         let mut partials = g.import_buffer(
             "meter partials",
@@ -165,12 +167,12 @@ impl Meter {
                 delta: DELTA,
                 covered: COVERED,
             })
-            .dispatch_groups([self.tiles_xy[0], self.tiles_xy[1], 1]);
+            .dispatch_groups([tiles_xy[0], tiles_xy[1], 1]);
         g.simple_pass("meter_reduce", &self.reduce)
             .read_buffer(&partials)
             .write_buffer(&mut result)
             .constants(&ReducePush {
-                tiles: self.tiles_xy[0] * self.tiles_xy[1],
+                tiles: tiles_xy[0] * tiles_xy[1],
                 key: KEY,
             })
             .dispatch_groups([1, 1, 1]);

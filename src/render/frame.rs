@@ -320,7 +320,7 @@ impl Frame {
             prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
             debug: DebugPass::new(ctx, &scene.regions)?,
             depth_range,
-            meter: Meter::new(ctx, (w, h), samplers.nearest.clone())?,
+            meter: Meter::new(ctx, samplers.nearest.clone())?,
             glow: Glow::new(ctx, samplers.nearest.clone(), samplers.linear.clone())?,
             tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
             sh: ShPasses::new(ctx, samplers.nearest.clone())?,

@@ -22,7 +22,8 @@ use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
 use crate::profile::{MemoryUse, RunReport, RunSetup};
 use crate::scene::checker;
-use crate::scene::file::{Chain, Kernel, Occlusion};
+use crate::scene::file::{Chain, Kernel, Occlusion, UvOrigin};
+use crate::scene::texture::flip_rows;
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
 use frame::{Frame, Kept};
@@ -207,6 +208,13 @@ pub const SHEET_VIEWS: [View; 15] = [
     View::Specular,
 ];
 
+/// Whether `view` is shown upside down from how it is stored: UV-space views are
+/// shown in the orientation of the scene's maps, and maps with their UV origin
+/// at the bottom left were flipped on load (scene::texture::flip_rows).
+fn flipped(scene: &Scene, view: View) -> bool {
+    view.uv_space() && scene.file.textures.uv_origin == UvOrigin::BottomLeft
+}
+
 /// One frame of each view, without progress bar or HDR image.
 fn single(opts: &RenderOptions) -> RenderOptions {
     RenderOptions {
@@ -311,7 +319,7 @@ fn run(
     }
     reports.extend(executor.finish()?);
     drop(progress);
-    let hdr = match &hdr_readback {
+    let mut hdr = match &hdr_readback {
         Some(b) => Some(
             b.bytes()?
                 .chunks_exact(2)
@@ -331,11 +339,17 @@ fn run(
         (Exposure::Given(ev), _) => ev,
         (Exposure::Metered, m) => m.map_or(0.0, |m| m.ev),
     };
-    let rgba8 = match (&ldr_readback, &hdr) {
+    let mut rgba8 = match (&ldr_readback, &hdr) {
         (Some(b), _) => b.bytes()?.to_vec(),
         (None, Some(values)) => encode8(values, ev, &display),
         (None, None) => Vec::new(),
     };
+    if flipped(scene, view) {
+        flip_rows(&mut rgba8, w as usize * 4);
+        if let Some(values) = &mut hdr {
+            flip_rows(values, w as usize * 4);
+        }
+    }
     let (allocated_bytes, reserved_bytes) = ctx.allocator_bytes();
     let memory = MemoryUse {
         transient_pool_bytes: executor.pool_bytes(),

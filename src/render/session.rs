@@ -112,7 +112,12 @@ impl Session {
             p.read(&ldr, Access::TransferSrc),
             p.write(&mut out, Access::TransferDst),
         );
-        p.record(move |cx| cx.copy_image(src, dst));
+        // As render writes it (render::flipped).
+        let flip = super::flipped(&self.scene, view);
+        p.record(move |cx| match flip {
+            true => cx.copy_image_flipped(src, dst),
+            false => cx.copy_image(src, dst),
+        });
         let compiled = self.executor.compile(g)?;
         let mut reports = self
             .executor

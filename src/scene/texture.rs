@@ -58,12 +58,16 @@ impl Texture {
     /// left (OpenGL) becomes one sampled with glTF's top-left origin, since the
     /// texel for (u, v) moves from row (1 − v)·h to row v·h.
     pub fn flip_vertical(&mut self) {
-        let row = self.width as usize * 4;
-        let h = self.height as usize;
-        for y in 0..h / 2 {
-            let (top, bottom) = self.rgba8.split_at_mut((h - 1 - y) * row);
-            top[y * row..(y + 1) * row].swap_with_slice(&mut bottom[..row]);
-        }
+        flip_rows(&mut self.rgba8, self.width as usize * 4);
+    }
+}
+
+/// Reverses the order of the rows of `row_len` elements in `pixels`.
+pub fn flip_rows<T>(pixels: &mut [T], row_len: usize) {
+    let h = pixels.len() / row_len.max(1);
+    for y in 0..h / 2 {
+        let (top, bottom) = pixels.split_at_mut((h - 1 - y) * row_len);
+        top[y * row_len..(y + 1) * row_len].swap_with_slice(&mut bottom[..row_len]);
     }
 }
 
