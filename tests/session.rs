@@ -149,24 +149,29 @@ fn a_session_shows_uv_views_as_render_writes_them() {
 }
 
 #[test]
-fn a_session_meters_the_frame_at_its_new_size() {
-    // The window grew: the frame is metered over all of its pixels.
+fn a_session_after_set_camera_is_a_fresh_session_with_that_camera() {
+    // The window grew and the camera moved in: the frame is metered over all of
+    // its pixels, and the depth view spans the mesh as seen from there.
     let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
     file.render.width = 48;
     file.render.height = 60;
     file.render.irradiance_resolution = 256;
     let small = Scene::load(file).unwrap();
-    let mut large = small.clone();
-    (large.file.render.width, large.file.render.height) = (96, 120);
+    let mut moved = small.clone();
+    (moved.file.render.width, moved.file.render.height) = (96, 120);
+    let c = &mut moved.camera;
+    c.position = c.target + 0.7 * (c.position - c.target);
     common::with_gpu(|ctx| {
-        let mut fresh = Session::new(ctx, large.clone()).unwrap();
-        let (image, _) = fresh.render(View::Final).unwrap();
-        let expected = pixels(ctx, &image);
-        let mut session = Session::new(ctx, small.clone()).unwrap();
-        session.render(View::Final).unwrap();
-        let camera = session.scene().camera;
-        session.set_camera(camera, (96, 120)).unwrap();
-        let (image, _) = session.render(View::Final).unwrap();
-        assert_eq!(differing(&pixels(ctx, &image), &expected), 0);
+        for view in [View::Final, View::Depth] {
+            let mut fresh = Session::new(ctx, moved.clone()).unwrap();
+            let (image, _) = fresh.render(view).unwrap();
+            let expected = pixels(ctx, &image);
+            let mut session = Session::new(ctx, small.clone()).unwrap();
+            session.render(view).unwrap();
+            session.set_camera(moved.camera, (96, 120)).unwrap();
+            let (image, _) = session.render(view).unwrap();
+            let n = differing(&pixels(ctx, &image), &expected);
+            assert_eq!(n, 0, "{}: bytes differing", view.name());
+        }
     });
 }

@@ -67,6 +67,17 @@ fn frame_lights(scene: &Scene, extracted: &[ExtractedLight]) -> Vec<Light> {
     all.into_iter().take(MAX_LIGHTS).collect()
 }
 
+/// Where the depth view's 1 and 0 lie: the mesh's nearest and farthest vertex
+/// along the camera's axis.
+fn depth_range(scene: &Scene) -> DepthRange {
+    let camera = &scene.camera;
+    DepthRange::of(
+        camera.position,
+        (camera.target - camera.position).normalize_or_zero(),
+        &scene.mesh.positions,
+    )
+}
+
 /// The shadow projection of each light (`None`: unshadowed).
 fn shadow_views(scene: &Scene, lights: &[Light]) -> Vec<Option<ShadowView>> {
     let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
@@ -299,12 +310,7 @@ impl Frame {
             skin.chain,
             levels
         );
-        let camera = &scene.camera;
-        let depth_range = DepthRange::of(
-            camera.position,
-            (camera.target - camera.position).normalize_or_zero(),
-            &scene.mesh.positions,
-        );
+        let depth_range = depth_range(scene);
         Ok(Self {
             tables,
             skybox: SkyboxPass::new(ctx)?,
@@ -345,8 +351,9 @@ impl Frame {
     }
 
     /// Moves the camera to `scene.camera` at the aspect of `scene.file.render`'s
-    /// size: the frame's uniforms are made again; nothing else changes.
+    /// size: the frame's uniforms and the depth view's range are made again.
     pub(super) fn set_camera(&mut self, ctx: &Arc<Context>, scene: &Scene) -> Result<()> {
+        self.depth_range = depth_range(scene);
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let uniforms = frame_uniforms(scene, &self.lights, w as f32 / h as f32, &self.views);
         self.inputs.uniforms = upload_buffer(
