@@ -33,6 +33,15 @@ fn pixels(ctx: &Arc<Context>, image: &Arc<Image>) -> Vec<u8> {
     readback.bytes().unwrap().to_vec()
 }
 
+/// The default scene (the scan under royal_esplanade, two extracted lamps) at
+/// `size`, irradiance 256².
+fn scan((width, height): (u32, u32)) -> Scene {
+    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
+    (file.render.width, file.render.height) = (width, height);
+    file.render.irradiance_resolution = 256;
+    Scene::load(file).unwrap()
+}
+
 /// Bytes that differ between two images of one size.
 fn differing(a: &[u8], b: &[u8]) -> usize {
     assert_eq!(a.len(), b.len());
@@ -41,12 +50,7 @@ fn differing(a: &[u8], b: &[u8]) -> usize {
 
 #[test]
 fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
-    // The scan under royal_esplanade: two extracted lamps, soft-shadowed.
-    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
-    file.render.width = 64;
-    file.render.height = 80;
-    file.render.irradiance_resolution = 256;
-    let scene = Scene::load(file).unwrap();
+    let scene = scan((64, 80));
     common::with_gpu(|ctx| {
         let mut fresh = Session::new(ctx, scene.clone()).unwrap();
         assert!(fresh.extracted_lights() > 0);
@@ -78,11 +82,7 @@ fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
 
 #[test]
 fn turning_the_environment_in_a_session_is_a_fresh_session_at_that_angle() {
-    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
-    file.render.width = 64;
-    file.render.height = 80;
-    file.render.irradiance_resolution = 256;
-    let scene = Scene::load(file).unwrap();
+    let scene = scan((64, 80));
     let mut turned = scene.clone();
     turned.file.environment.rotation_deg = 120.0;
     common::with_gpu(|ctx| {
@@ -110,11 +110,7 @@ fn turning_the_environment_in_a_session_is_a_fresh_session_at_that_angle() {
 fn a_session_shows_uv_views_as_render_writes_them() {
     // The scan's maps have their UV origin at the bottom left: both paths flip
     // its UV-space views (tests/views.rs checks render's against the UVs).
-    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
-    file.render.width = 64;
-    file.render.height = 80;
-    file.render.irradiance_resolution = 256;
-    let scene = Scene::load(file).unwrap();
+    let scene = scan((64, 80));
     let (shown, written) = common::with_gpu(|ctx| {
         let mut session = Session::new(ctx, scene.clone()).unwrap();
         let (image, _) = session.render(View::Irradiance).unwrap();
@@ -152,11 +148,7 @@ fn a_session_shows_uv_views_as_render_writes_them() {
 fn a_session_after_set_camera_is_a_fresh_session_with_that_camera() {
     // The window grew and the camera moved in: the frame is metered over all of
     // its pixels, and the depth view spans the mesh as seen from there.
-    let mut file = load_scene(std::path::Path::new("assets/default.toml")).unwrap();
-    file.render.width = 48;
-    file.render.height = 60;
-    file.render.irradiance_resolution = 256;
-    let small = Scene::load(file).unwrap();
+    let small = scan((48, 60));
     let mut moved = small.clone();
     (moved.file.render.width, moved.file.render.height) = (96, 120);
     let c = &mut moved.camera;

@@ -259,12 +259,7 @@ impl<'a> PassCx<'a> {
     /// same size and format.
     pub fn copy_image(&self, src: ImageRef, dst: ImageRef) {
         let (s, d) = (self.image(src), self.image(dst));
-        let layers = vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
+        let layers = color_layers(0);
         let region = vk::ImageCopy::default()
             .src_subresource(layers)
             .dst_subresource(layers)
@@ -289,12 +284,7 @@ impl<'a> PassCx<'a> {
     /// order: a blit from the bottom row up.
     pub fn copy_image_flipped(&self, src: ImageRef, dst: ImageRef) {
         let (s, d) = (self.image(src), self.image(dst));
-        let layers = vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
+        let layers = color_layers(0);
         let (w, h) = (s.desc.width as i32, s.desc.height as i32);
         let region = vk::ImageBlit2::default()
             .src_subresource(layers)
@@ -323,12 +313,7 @@ impl<'a> PassCx<'a> {
     pub fn copy_level_to_buffer(&self, image: ImageRef, level: u32, buffer: BufferRef) {
         let img = self.image(image);
         let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: level,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
+            .image_subresource(color_layers(level))
             .image_extent(vk::Extent3D {
                 width: (img.desc.width >> level).max(1),
                 height: (img.desc.height >> level).max(1),
@@ -348,12 +333,7 @@ impl<'a> PassCx<'a> {
     pub fn copy_buffer_to_image(&self, buffer: BufferRef, image: ImageRef) {
         let img = self.image(image);
         let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
+            .image_subresource(color_layers(0))
             .image_extent(vk::Extent3D {
                 width: img.desc.width,
                 height: img.desc.height,
@@ -417,16 +397,10 @@ impl<'a> PassCx<'a> {
                 )
             };
             let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-            let layers = |mip| vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: mip,
-                base_array_layer: 0,
-                layer_count: 1,
-            };
             let region = vk::ImageBlit2::default()
-                .src_subresource(layers(i - 1))
+                .src_subresource(color_layers(i - 1))
                 .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
-                .dst_subresource(layers(i))
+                .dst_subresource(color_layers(i))
                 .dst_offsets([vk::Offset3D::default(), vk::Offset3D { x: nw, y: nh, z: 1 }]);
             let regions = [region];
             let blit = vk::BlitImageInfo2::default()
@@ -468,5 +442,15 @@ impl<'a> PassCx<'a> {
                 &[full_range(img.desc.format, img.desc.mip_levels)],
             )
         };
+    }
+}
+
+/// Mip `level` of a colour image's single layer, for copies and blits.
+fn color_layers(level: u32) -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: level,
+        base_array_layer: 0,
+        layer_count: 1,
     }
 }
