@@ -2,11 +2,13 @@
 //! time; run reports with statistics over warmed-up frames; trace and CSV output.
 
 pub mod csv;
+pub mod fingerprint;
 mod run;
 mod stats;
 pub mod trace;
 
 pub use run::{MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, RULER_COPY, VERSION};
+pub use fingerprint::Fingerprint;
 pub use stats::Stats;
 
 use serde::Serialize;

@@ -91,14 +91,20 @@ pub struct PassStats {
     pub gb_per_s: Option<f64>,
     /// ns/texel as a multiple of the copy ruler's in the same run.
     pub x_ruler: Option<f64>,
+    /// The measured frames' times in frame order, `None` where a frame did not
+    /// time it (`dermis compare` resamples these).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub samples_ns: Vec<Option<f64>>,
 }
 
 impl PassStats {
-    fn of(name: &str, values: Vec<f64>) -> Self {
+    fn of(name: &str, values: Vec<Option<f64>>) -> Self {
+        let finite: Vec<f64> = values.iter().flatten().copied().collect();
         Self {
             name: name.into(),
-            frames: values.iter().filter(|v| v.is_finite()).count(),
-            time: Stats::of(&values),
+            frames: finite.iter().filter(|v| v.is_finite()).count(),
+            time: Stats::of(&finite),
+            samples_ns: values,
             ..Default::default()
         }
     }
@@ -172,7 +178,7 @@ impl RunReport {
         let mut passes: Vec<PassStats> = names
             .iter()
             .map(|n| {
-                let v = measured.iter().filter_map(|f| f.pass_ns(n)).collect();
+                let v = measured.iter().map(|f| f.pass_ns(n)).collect();
                 let work = measured.iter().rev().find_map(|f| f.pass(n));
                 PassStats::of(n, v)
                     .with_work(work.and_then(|p| p.texels), work.and_then(|p| p.bytes))
@@ -185,7 +191,7 @@ impl RunReport {
         for p in &mut passes {
             p.x_ruler = p.ns_per_texel.zip(ruler).map(|(a, r)| a / r);
         }
-        let spans = measured.iter().filter_map(|f| f.gpu_frame_ns).collect();
+        let spans = measured.iter().map(|f| f.gpu_frame_ns).collect();
         let warmup_only = per_frame[..warmup]
             .iter()
             .flat_map(|f| &f.passes)
@@ -424,7 +430,7 @@ pub(super) mod tests {
     #[test]
     fn per_texel_figures_follow_from_work_and_median() {
         let mut s =
-            PassStats::of("p", vec![2000.0, 4000.0, 3000.0]).with_work(Some(1000), Some(6000));
+            PassStats::of("p", vec![Some(2000.0), Some(4000.0), Some(3000.0)]).with_work(Some(1000), Some(6000));
         assert_eq!(s.ns_per_texel, Some(3.0));
         assert_eq!(s.gb_per_s, Some(2.0));
         s = s.with_work(None, Some(0));
