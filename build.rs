@@ -59,8 +59,11 @@ fn stage_of(path: &Path) -> Option<ShaderStage> {
 /// branch it names moves (worktrees keep HEAD apart from the refs).
 fn git_commit(manifest: &Path) {
     println!("cargo:rerun-if-env-changed=DERMIS_GIT_COMMIT");
+    println!("cargo:rerun-if-env-changed=DERMIS_GIT_DIRTY");
     if let Ok(given) = std::env::var("DERMIS_GIT_COMMIT") {
+        let dirty = std::env::var("DERMIS_GIT_DIRTY").unwrap_or_else(|_| "false".into());
         println!("cargo:rustc-env=DERMIS_GIT_COMMIT={given}");
+        println!("cargo:rustc-env=DERMIS_GIT_DIRTY={}", dirty == "true");
         return;
     }
     let git = |args: &[&str]| -> Option<String> {
@@ -104,8 +107,24 @@ fn git_commit(manifest: &Path) {
         }
         watch(&common.join("packed-refs"));
     }
+    // Dirty: the sources the binary is built from differ from the commit (edits,
+    // or new files not yet committed). Cargo rescans these folders for changes.
+    let built_from = [
+        "src",
+        "shaders-glsl",
+        "build.rs",
+        "Cargo.toml",
+        "Cargo.lock",
+    ];
+    let mut status = vec!["status", "--porcelain", "--"];
+    status.extend(built_from);
+    let dirty = commit.is_some() && git(&status).is_some();
+    for path in built_from {
+        watch(&manifest.join(path));
+    }
     let commit = commit.unwrap_or_else(|| "unknown".into());
     println!("cargo:rustc-env=DERMIS_GIT_COMMIT={commit}");
+    println!("cargo:rustc-env=DERMIS_GIT_DIRTY={dirty}");
 }
 
 fn main() {

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use dermis::gpu::{Context, ContextOptions};
 use dermis::light::extract;
+use dermis::profile::compare::{self, Comparison, Measurement};
 use dermis::render::output::{write_sheet, Format};
 use dermis::render::{compare_occlusion, debug_sheet, render_scene, RenderOptions, View};
 use dermis::scene::file::{
@@ -25,7 +26,8 @@ Environment:
 
 Exit status:
   0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver,
-  window system).";
+  window system); compare and interleave with --fail-on-regression: 3 when a pass
+  regressed.";
 
 #[derive(Parser)]
 #[command(
@@ -230,6 +232,67 @@ enum Command {
         #[arg(long)]
         screenshot: Option<PathBuf>,
     },
+    /// Compare two measurements pass by pass: the change of each pass's median
+    /// (in ruler units where both sides ran --ruler, else ms), a bootstrap 95 %
+    /// interval, a Mann-Whitney U p-value Holm-corrected over the passes, and a
+    /// verdict: regressed / improved / unchanged / inconclusive (docs/performance.md,
+    /// "Comparing runs").
+    #[command(after_help = AFTER_HELP)]
+    Compare {
+        /// The base: a run report (render --report), a folder of reports (pooled
+        /// as runs of one setup), or a sweep (sweep.json).
+        base: PathBuf,
+        /// The new measurement, of the same kind.
+        new: PathBuf,
+        #[command(flatten)]
+        decide: DecideArgs,
+    },
+    /// Run two binaries or two option sets alternately (A B B A A B …: drift
+    /// cancels), each run a process of `render --frames F --ruler --report`, then
+    /// compare them as `dermis compare` does.
+    #[command(after_help = AFTER_HELP)]
+    Interleave {
+        /// Runs per side.
+        #[arg(long, default_value_t = 10)]
+        runs: u32,
+        /// Frames per run (the first is warm-up).
+        #[arg(long, default_value_t = 3)]
+        frames: u32,
+        /// The base's dermis binary (default: this one).
+        #[arg(long)]
+        base_bin: Option<PathBuf>,
+        /// The new side's dermis binary (default: this one).
+        #[arg(long)]
+        new_bin: Option<PathBuf>,
+        /// The base's render options, as one shell-quoted string
+        /// (e.g. "--irradiance-res 1024").
+        #[arg(long, default_value = "", allow_hyphen_values = true)]
+        base_args: String,
+        /// The new side's render options (e.g. "--irradiance-res 1024 --kernel accurate").
+        #[arg(long, default_value = "", allow_hyphen_values = true)]
+        new_args: String,
+        /// Where the runs' reports (base-K.json, new-K.json) and images go (created).
+        #[arg(long, default_value = "interleave")]
+        out_dir: PathBuf,
+        #[command(flatten)]
+        decide: DecideArgs,
+    },
+    /// Convert a run report for CI dashboards: github-action-benchmark
+    /// (`customSmallerIsBetter`) and Bencher Metric Format JSON.
+    #[command(after_help = AFTER_HELP)]
+    Export {
+        /// A run report (render --report).
+        report: PathBuf,
+        /// Write github-action-benchmark's customSmallerIsBetter JSON here.
+        #[arg(long, value_name = "FILE.json")]
+        github_benchmark: Option<PathBuf>,
+        /// Write Bencher Metric Format (BMF) JSON here.
+        #[arg(long, value_name = "FILE.json")]
+        bencher: Option<PathBuf>,
+    },
+    /// Print the JSON Schema of run reports (docs/report.schema.json).
+    #[command(after_help = AFTER_HELP)]
+    ReportSchema,
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
     Render {
@@ -325,9 +388,18 @@ enum Command {
         /// exposure; the paper's Figs. 6–8).
         #[arg(long, value_name = "FILE.png")]
         compare_occlusion: Option<PathBuf>,
-        /// Frames to render (≥ 1); with more than one the first is warm-up.
+        /// Frames to render per run (≥ 1); with more than one the first is warm-up.
         #[arg(long, default_value_t = 1)]
         frames: u32,
+        /// Warm-up frames per run, outside the statistics (default: 1 when
+        /// --frames is more than 1, else 0).
+        #[arg(long)]
+        warmup: Option<u32>,
+        /// Independent repetitions, each with a fresh upload, pipelines and
+        /// warm-up, so that `dermis compare` has runs, not only frames of one
+        /// pipeline state; the image is the last run's.
+        #[arg(long, default_value_t = 1)]
+        runs: u32,
         /// Print the per-pass GPU time table (median, min, max, p90 of measured frames).
         #[arg(long)]
         timings: bool,
@@ -350,6 +422,34 @@ enum Command {
         #[arg(long)]
         ruler: bool,
     },
+}
+
+/// How `compare` and `interleave` decide and what they write.
+#[derive(clap::Args)]
+struct DecideArgs {
+    /// What each pass's time is compared in: `ruler` (over the ruler pass of
+    /// its frame or run: a busier machine cancels), `ms`, or `auto` (ruler units
+    /// where they scatter less between samples than ms).
+    #[arg(long, value_enum, default_value = "auto")]
+    unit: compare::Unit,
+    /// Relative change below which a pass is not reported changed (0.03 = 3 %).
+    #[arg(long, default_value_t = compare::DEFAULT_NOISE_THRESHOLD)]
+    noise_threshold: f64,
+    /// Family-wise significance level (Holm-corrected over the passes).
+    #[arg(long, default_value_t = compare::DEFAULT_SIGNIFICANCE)]
+    significance: f64,
+    /// Compare even where the work differs (scene, mesh, view, sizes).
+    #[arg(long)]
+    allow_setup_change: bool,
+    /// Print the comparison as JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Also write a JUnit XML summary (one test case per pass, failed when regressed).
+    #[arg(long, value_name = "FILE.xml")]
+    junit: Option<PathBuf>,
+    /// Exit with status 3 when any pass regressed.
+    #[arg(long)]
+    fail_on_regression: bool,
 }
 
 /// `--background R,G,B`.
@@ -384,7 +484,7 @@ fn main() -> ExitCode {
     };
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level)).init();
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(e.exit_code() as u8)
@@ -392,7 +492,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> dermis::Result<()> {
+fn run(cli: Cli) -> dermis::Result<ExitCode> {
     let mut context = ContextOptions::from_env();
     context.validation |= cli.validation;
     context.device = cli.device.or(context.device);
@@ -428,7 +528,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                     );
                 }
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Precompute {
             scene,
@@ -457,7 +557,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 secs * 1e6 / t.coeffs.len().max(1) as f64,
                 dermis::light::occlusion::default_cache_dir().display()
             );
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Sh {
             env,
@@ -489,7 +589,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             if timings {
                 eprint!("{}", report.table());
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Lights {
             env,
@@ -572,7 +672,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 }
                 println!("residual: {:.1} % of the energy", 100.0 * residual);
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Sweep {
             scene,
@@ -591,7 +691,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
                 dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
                 println!("redrew {}", out_dir.display());
-                return Ok(());
+                return Ok(ExitCode::SUCCESS);
             }
             let file = Overrides {
                 width,
@@ -649,7 +749,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
             dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
             println!("wrote {}", out_dir.display());
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Reference {
             scene,
@@ -702,7 +802,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             } else {
                 print!("{}", dermis::sweep::lighting::table(&rows));
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::View {
             scene,
@@ -731,7 +831,69 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 context,
                 frames,
                 screenshot,
-            })
+            })?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Compare { base, new, decide } => {
+            let (base, mut warnings) = load_side(&base)?;
+            let (new, more) = load_side(&new)?;
+            warnings.extend(more);
+            report_comparison(&base, &new, &decide, warnings)
+        }
+        Command::Interleave {
+            runs,
+            frames,
+            base_bin,
+            new_bin,
+            base_args,
+            new_args,
+            out_dir,
+            decide,
+        } => {
+            let me = std::env::current_exe().map_err(|source| dermis::Error::Io {
+                path: "the running dermis binary".into(),
+                source,
+            })?;
+            let sides = [
+                ("base", base_bin.unwrap_or_else(|| me.clone()), base_args),
+                ("new", new_bin.unwrap_or(me), new_args),
+            ];
+            let [base, new] = interleave(&sides, runs, frames, &out_dir)?;
+            report_comparison(&base.0, &new.0, &decide, [base.1, new.1].concat())
+        }
+        Command::Export {
+            report,
+            github_benchmark,
+            bencher,
+        } => {
+            if github_benchmark.is_none() && bencher.is_none() {
+                return Err(dermis::Error::Input(
+                    "export: give --github-benchmark FILE or --bencher FILE".into(),
+                ));
+            }
+            let text = read_text(&report)?;
+            let r: dermis::profile::RunReport = serde_json::from_str(&text).map_err(|e| {
+                dermis::Error::Input(format!(
+                    "{}: not a dermis run report: {e}",
+                    report.display()
+                ))
+            })?;
+            if let Some(path) = github_benchmark {
+                let v = dermis::profile::export::github_benchmark(&r);
+                write_file(&path, &to_json(&path, &v)?)?;
+            }
+            if let Some(path) = bencher {
+                write_file(
+                    &path,
+                    &to_json(&path, &dermis::profile::export::bencher(&r))?,
+                )?;
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::ReportSchema => {
+            let schema = schemars::schema_for!(dermis::profile::RunReport);
+            println!("{}", to_json(Path::new("stdout"), &schema)?);
+            Ok(ExitCode::SUCCESS)
         }
         Command::Render {
             scene,
@@ -761,6 +923,8 @@ fn run(cli: Cli) -> dermis::Result<()> {
             debug_sheet: sheet,
             compare_occlusion: comparison,
             frames,
+            warmup,
+            runs,
             timings,
             report,
             trace,
@@ -796,9 +960,6 @@ fn run(cli: Cli) -> dermis::Result<()> {
             for path in [&sheet, &comparison].into_iter().flatten() {
                 Format::of(path)?;
             }
-            let file = overrides.apply(file)?;
-            let loaded = Scene::load(file)?;
-            let ctx = Context::new(&context)?;
             let opts = RenderOptions {
                 frames,
                 hdr,
@@ -806,7 +967,13 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 scene_path: Some(scene.unwrap_or_else(default_scene_path)),
                 progress: std::io::stderr().is_terminal(),
                 ruler,
+                runs,
+                warmup,
             };
+            opts.warmup_frames()?;
+            let file = overrides.apply(file)?;
+            let loaded = Scene::load(file)?;
+            let ctx = Context::new(&context)?;
             let output = render_scene(&ctx, &loaded, &opts)?;
             if dump_graph {
                 print!("{}", output.plan);
@@ -824,6 +991,9 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 );
             }
             let r = &output.report;
+            if let Some(w) = r.cold_warning().filter(|_| timings || report.is_some()) {
+                eprintln!("{w}");
+            }
             if timings {
                 print!("{}{}", r.header(), r.table());
             }
@@ -854,7 +1024,170 @@ fn run(cli: Cli) -> dermis::Result<()> {
                 write_sheet(&path, &compare_occlusion(&ctx, &loaded, &opts)?)?;
                 println!("wrote {}", path.display());
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+fn read_text(path: &Path) -> dermis::Result<String> {
+    std::fs::read_to_string(path).map_err(|source| dermis::Error::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// One side of `compare`: a report, or a folder of reports pooled as runs.
+fn load_side(path: &Path) -> dermis::Result<(Measurement, Vec<String>)> {
+    let files = if path.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+            .map_err(|source| dermis::Error::Io {
+                path: path.display().to_string(),
+                source,
+            })?
+            .filter_map(|e| Some(e.ok()?.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            return Err(dermis::Error::Input(format!(
+                "{}: no .json reports in this folder",
+                path.display()
+            )));
+        }
+        files
+    } else {
+        vec![path.to_path_buf()]
+    };
+    let parts = files
+        .iter()
+        .map(|f| Measurement::from_report_json(&read_text(f)?, &f.display().to_string()))
+        .collect::<dermis::Result<Vec<_>>>()?;
+    let (mut m, warnings) = Measurement::pool(parts)?;
+    if files.len() > 1 {
+        m.source = format!("{} ({} reports)", path.display(), files.len());
+    }
+    Ok((m, warnings))
+}
+
+/// Compares, prints the table (or JSON), writes the JUnit file; status 3 on
+/// a regression when asked.
+fn report_comparison(
+    base: &Measurement,
+    new: &Measurement,
+    decide: &DecideArgs,
+    warnings: Vec<String>,
+) -> dermis::Result<ExitCode> {
+    let opts = compare::CompareOptions {
+        unit: decide.unit,
+        noise_threshold: decide.noise_threshold,
+        significance: decide.significance,
+        allow_setup_change: decide.allow_setup_change,
+    };
+    let mut c: Comparison = compare::compare(base, new, &opts)?;
+    c.warnings.splice(0..0, warnings);
+    if decide.json {
+        println!("{}", to_json(Path::new("stdout"), &c)?);
+    } else {
+        print!("{}", compare::table(&c));
+    }
+    if let Some(path) = &decide.junit {
+        write_file(path, &dermis::profile::export::junit(&c))?;
+    }
+    Ok(if decide.fail_on_regression && c.regressed() {
+        ExitCode::from(3)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Options `interleave` sets itself on each run.
+const INTERLEAVE_OWNS: [&str; 5] = ["--report", "--out", "--frames", "--runs", "--ruler"];
+
+/// Runs each side `runs` times as separate processes, alternating A B B A …,
+/// and reads their reports back, pooled per side.
+fn interleave(
+    sides: &[(&str, PathBuf, String); 2],
+    runs: u32,
+    frames: u32,
+    out_dir: &Path,
+) -> dermis::Result<[(Measurement, Vec<String>); 2]> {
+    if runs < 2 || frames < 2 {
+        return Err(dermis::Error::Input(format!(
+            "interleave: --runs {runs} --frames {frames}: give at least 2 of each \
+             (runs are the samples; each run's first frame is warm-up)"
+        )));
+    }
+    let mut args = Vec::new();
+    for (name, bin, text) in sides {
+        let a = shlex::split(text).ok_or_else(|| {
+            dermis::Error::Input(format!("--{name}-args {text:?}: unbalanced quotes"))
+        })?;
+        if let Some(owned) = a.iter().find(|x| {
+            INTERLEAVE_OWNS
+                .iter()
+                .any(|o| x.split('=').next() == Some(o))
+        }) {
+            return Err(dermis::Error::Input(format!(
+                "--{name}-args: {owned} is set by interleave itself ({})",
+                INTERLEAVE_OWNS.join(", ")
+            )));
+        }
+        if !bin.is_file() {
+            return Err(dermis::Error::Input(format!(
+                "--{name}-bin {}: no such file",
+                bin.display()
+            )));
+        }
+        args.push(a);
+    }
+    std::fs::create_dir_all(out_dir).map_err(|source| dermis::Error::Io {
+        path: out_dir.display().to_string(),
+        source,
+    })?;
+    let mut files: [Vec<PathBuf>; 2] = [Vec::new(), Vec::new()];
+    for k in 0..runs {
+        // A B, then B A: a linear drift falls on both sides alike.
+        let order = if k % 2 == 0 { [0, 1] } else { [1, 0] };
+        for i in order {
+            let (name, bin, _) = &sides[i];
+            let report = out_dir.join(format!("{name}-{k:03}.json"));
+            let started = std::time::Instant::now();
+            let status = std::process::Command::new(bin)
+                .arg("render")
+                .args(&args[i])
+                .args(["--frames", &frames.to_string(), "--ruler", "--report"])
+                .arg(&report)
+                .arg("--out")
+                .arg(out_dir.join(format!("{name}.png")))
+                .stdout(std::process::Stdio::null())
+                .status()
+                .map_err(|source| dermis::Error::Io {
+                    path: bin.display().to_string(),
+                    source,
+                })?;
+            if !status.success() {
+                return Err(dermis::Error::Input(format!(
+                    "interleave: {name} run {} of {runs} ({} render …) failed: {status}",
+                    k + 1,
+                    bin.display()
+                )));
+            }
+            eprintln!(
+                "{name} {}/{runs}: {:.1} s",
+                k + 1,
+                started.elapsed().as_secs_f64()
+            );
+            files[i].push(report);
+        }
+    }
+    let pool = |f: &[PathBuf]| -> dermis::Result<(Measurement, Vec<String>)> {
+        let parts = f
+            .iter()
+            .map(|p| Measurement::from_report_json(&read_text(p)?, &p.display().to_string()))
+            .collect::<dermis::Result<Vec<_>>>()?;
+        let (mut m, w) = Measurement::pool(parts)?;
+        m.source = format!("{} × {}", f.len(), f[0].display());
+        Ok((m, w))
+    };
+    Ok([pool(&files[0])?, pool(&files[1])?])
 }

@@ -67,7 +67,9 @@ fn render_writes_png_report_and_graph() {
     assert_eq!(report["warmup_frames"], 1);
     let passes = report["median"]["passes"].as_array().unwrap();
     assert!(passes.iter().all(|p| p["gpu_ns"].as_f64().unwrap() > 0.0));
-    assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
+    assert!(report["fingerprint"]["device"]
+        .as_str()
+        .is_some_and(|d| !d.is_empty()));
 }
 
 /// Splits a CSV line, honouring quoted fields (with "" for a quote).
@@ -145,7 +147,24 @@ fn render_writes_self_describing_report_trace_and_csv() {
     assert!(setup["occlusion"].is_string());
     assert_eq!(r["dermis_version"], env!("CARGO_PKG_VERSION"));
     assert!(r["git_commit"].as_str().is_some_and(|c| !c.is_empty()));
-    assert!(r["clock"] == "host-fence" || r["clock"] == "gpu-timestamp");
+    let fp = &r["fingerprint"];
+    assert!(fp["clock"] == "host-fence" || fp["clock"] == "gpu-timestamp");
+    assert!(fp["cpu_model"].as_str().is_some_and(|c| !c.is_empty()));
+    assert!(fp["cpu_cores"].as_u64().is_some_and(|c| c >= 1));
+    assert_eq!(fp["validation"], true);
+    // Enough to reproduce: the command line, when, from which sources.
+    assert_eq!(r["schema_version"], dermis::profile::SCHEMA_VERSION);
+    let args = r["command_line"].as_array().unwrap();
+    assert!(args.iter().any(|a| a == "--irradiance-res"), "{args:?}");
+    assert!(r["timestamp"].as_str().is_some_and(|t| t.ends_with('Z')));
+    assert!(r["git_dirty"].is_boolean());
+    assert!(r["run_id"].as_str().is_some_and(|id| !id.is_empty()));
+    for key in ["gamma", "skybox", "background", "uv_origin", "mm_per_unit"] {
+        assert!(setup.get(key).is_some(), "setup lacks {key}: {setup}");
+    }
+    assert!(setup["camera"]["fov_y_deg"]
+        .as_f64()
+        .is_some_and(|f| f > 0.0));
     let memory = &r["memory"];
     let bytes = |k: &str| memory[k].as_u64().unwrap();
     assert!(bytes("transient_pool_bytes") > 0);
@@ -161,6 +180,12 @@ fn render_writes_self_describing_report_trace_and_csv() {
             "{p}"
         );
         assert!(v("p90_ns") <= v("max_ns"), "{p}");
+        assert!(
+            v("min_ns") <= v("mean_ns") && v("mean_ns") <= v("max_ns"),
+            "{p}"
+        );
+        assert!(v("std_ns") >= 0.0, "{p}");
+        assert_eq!(p["samples_ns"].as_array().unwrap().len(), 2, "{p}");
     }
     let frames = r["per_frame"].as_array().unwrap();
     assert_eq!(frames.len(), 3);
@@ -212,6 +237,12 @@ fn render_writes_self_describing_report_trace_and_csv() {
         "irradiance_resolution",
         "kernel",
         "view",
+        "run_id",
+        "run",
+        "scene",
+        "environment",
+        "device",
+        "git_commit",
     ] {
         assert!(header.iter().any(|h| h == column), "{column} in {header:?}");
     }
@@ -230,6 +261,10 @@ fn render_writes_self_describing_report_trace_and_csv() {
         assert_eq!(row.len(), header.len(), "{line}");
         assert_eq!(row[col("irradiance_resolution")], "256");
         assert_eq!(row[col("view")], "final");
+        // Concatenated runs stay apart: every row names its run and machine.
+        assert_eq!(row[col("run_id")], r["run_id"].as_str().unwrap());
+        assert_eq!(row[col("device")], fp["device"].as_str().unwrap());
+        assert!(row[col("scene")].ends_with("default.toml"), "{line}");
         rows_per_frame[row[col("frame")].parse::<usize>().unwrap()] += 1;
     }
     assert_eq!(rows_per_frame.to_vec(), per_frame);
@@ -677,6 +712,11 @@ fn precompute_fills_the_cache_and_reports_time() {
 #[test]
 fn zero_frames_is_a_clean_input_error() {
     assert_bad_input(&["--frames", "0", "--irradiance-res", "256"], "0 frames");
+    assert_bad_input(&["--runs", "0", "--irradiance-res", "256"], "0 runs");
+    assert_bad_input(
+        &["--frames", "3", "--warmup", "3", "--irradiance-res", "256"],
+        "--warmup 3 leaves none of --frames 3 measured",
+    );
 }
 
 #[test]

@@ -323,6 +323,7 @@ impl Executor {
             cpu_submit_ns: submit_ns,
             dropped_deltas: 0,
             clock: "host-fence".into(),
+            ..Default::default()
         })
     }
 

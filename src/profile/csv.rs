@@ -3,8 +3,8 @@
 
 use super::run::RunReport;
 
-pub const HEADER: &str = "frame,warmup,pass,start_ns,duration_ns,clock,\
-irradiance_resolution,kernel,chain,view,width,height,device,git_commit";
+pub const HEADER: &str = "run_id,run,frame,warmup,pass,start_ns,duration_ns,clock,\
+scene,environment,irradiance_resolution,kernel,chain,view,width,height,device,git_commit";
 
 /// RFC 4180 quoting where a field needs it.
 fn field(s: &str) -> String {
@@ -23,25 +23,28 @@ fn ns(v: Option<f64>) -> String {
 pub fn csv(report: &RunReport) -> String {
     let s = &report.setup;
     let run = [
+        field(&s.scene),
+        field(&s.environment),
         s.irradiance_resolution.to_string(),
         field(&s.kernel),
         field(&s.chain),
         field(&s.view),
         report.width.to_string(),
         report.height.to_string(),
-        field(&report.device),
+        field(&report.fingerprint.device),
         field(&report.git_commit),
     ]
     .join(",");
     let mut out = String::from(HEADER);
     out.push('\n');
     for f in &report.per_frame {
-        let warmup = (f.frame as usize) < report.warmup_frames;
         for p in &f.passes {
             out += &format!(
-                "{},{},{},{},{},{},{run}\n",
+                "{},{},{},{},{},{},{},{},{run}\n",
+                field(&report.run_id),
+                f.run,
                 f.frame,
-                warmup,
+                f.warmup,
                 field(&p.name),
                 ns(p.start_ns),
                 ns(p.gpu_ns),
@@ -68,13 +71,20 @@ mod tests {
         // The device name has a comma: quoted, so every row has the header's columns.
         assert_eq!(
             lines[3],
-            "1,false,a,10,10,host-fence,256,deon7,full,final,64,48,\"test device, 2 cores\","
-                .to_string()
-                + GIT_COMMIT
+            format!(
+                "{},0,1,false,a,10,10,host-fence,default,sky,256,deon7,full,final,64,48,\
+                 \"test device, 2 cores\",{GIT_COMMIT}",
+                r.run_id
+            )
         );
-        assert!(lines[1].starts_with("0,true,a,10,30,"), "{}", lines[1]);
+        let id = &r.run_id;
         assert!(
-            lines[6].starts_with("2,false,b,30,,host-fence,"),
+            lines[1].starts_with(&format!("{id},0,0,true,a,10,30,")),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[6].starts_with(&format!("{id},0,2,false,b,30,,host-fence,")),
             "{}",
             lines[6]
         );

@@ -4,9 +4,10 @@
 //! runs of different machines; Bencher keys thresholds by testbed).
 
 use crate::gpu::DeviceInfo;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 pub struct Fingerprint {
     pub device: String,
     /// Vulkan's device type: "CPU", "discrete GPU", …
@@ -48,9 +49,17 @@ impl Fingerprint {
         let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "unset".into());
         [
             ("device", self.device.clone(), other.device.clone()),
-            ("device_type", self.device_type.clone(), other.device_type.clone()),
+            (
+                "device_type",
+                self.device_type.clone(),
+                other.device_type.clone(),
+            ),
             ("driver", self.driver.clone(), other.driver.clone()),
-            ("api_version", self.api_version.clone(), other.api_version.clone()),
+            (
+                "api_version",
+                self.api_version.clone(),
+                other.api_version.clone(),
+            ),
             ("cpu_model", self.cpu_model.clone(), other.cpu_model.clone()),
             (
                 "cpu_cores",

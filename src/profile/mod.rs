@@ -1,17 +1,25 @@
 //! Frame reports: per-pass GPU time and start within the frame, CPU record/submit
 //! time; run reports with statistics over warmed-up frames; trace and CSV output.
 
+mod bootstrap;
+pub mod compare;
 pub mod csv;
+pub mod export;
 pub mod fingerprint;
 mod run;
+mod significance;
 mod stats;
 pub mod trace;
 
-pub use run::{MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, RULER_COPY, VERSION};
 pub use fingerprint::Fingerprint;
+pub use run::{
+    CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY, RULER_COPY,
+    SCHEMA_VERSION, VERSION,
+};
 pub use stats::Stats;
 
-use serde::Serialize;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// What a pass is measured against: the texels (invocations, or pixels of its
 /// render area) it computes and its nominal memory traffic, every graph image and
@@ -23,7 +31,7 @@ pub struct PassWork {
 }
 
 /// GPU time of one pass of one frame.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 pub struct PassTime {
     pub name: String,
     /// `None`: the pass said nothing about its size.
@@ -38,9 +46,16 @@ pub struct PassTime {
 }
 
 /// What one frame cost.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 pub struct FrameReport {
+    /// The repetition (`render --runs`) it belongs to, from 0.
+    #[serde(default)]
+    pub run: u32,
+    /// Within its run, from 0.
     pub frame: u64,
+    /// A warm-up frame, outside the statistics.
+    #[serde(default)]
+    pub warmup: bool,
     /// The frame's start after the executor's first frame's, on the same clock.
     pub start_ns: Option<f64>,
     pub passes: Vec<PassTime>,
@@ -158,6 +173,7 @@ impl FrameReport {
             cpu_submit_ns: med(frames.iter().map(|f| f.cpu_submit_ns).collect()).unwrap_or(0.0),
             dropped_deltas: frames.iter().map(|f| f.dropped_deltas).sum(),
             clock: last.clock.clone(),
+            ..Default::default()
         })
     }
 

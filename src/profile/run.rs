@@ -1,17 +1,52 @@
 //! What `--report FILE.json` writes: what was run, where, and what it cost.
 
+use super::fingerprint::{run_id, timestamp, Fingerprint};
 use super::stats::Stats;
 use super::{FrameReport, PassTime};
 use crate::gpu::DeviceInfo;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// The dermis version the report was made by.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// `git rev-parse --short HEAD` at build time (build.rs), or "unknown".
 pub const GIT_COMMIT: &str = env!("DERMIS_GIT_COMMIT");
+/// Whether the built sources differed from that commit (build.rs).
+pub const GIT_DIRTY: bool = const_str_eq(env!("DERMIS_GIT_DIRTY"), "true");
+
+/// The version of the report's JSON layout (`docs/report.schema.json`): 2 added
+/// the fingerprint, runs, samples, mean and standard deviation.
+pub const SCHEMA_VERSION: u32 = 2;
+
+const fn const_str_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// The camera as rendered, in millimetres.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CameraSetup {
+    pub position_mm: [f32; 3],
+    pub target_mm: [f32; 3],
+    pub up: [f32; 3],
+    pub fov_y_deg: f32,
+    pub near_mm: f32,
+    pub far_mm: f32,
+}
 
 /// What was rendered, as the caller resolved it: enough to run it again.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(default)]
 pub struct RunSetup {
     /// The scene file, or "default".
     pub scene: String,
@@ -55,10 +90,21 @@ pub struct RunSetup {
     pub blur_amount: f32,
     /// The test texture replaced the albedo.
     pub test_texture: bool,
+    /// Output transfer: `srgb` or a power (`2.2`).
+    pub gamma: String,
+    /// The environment drawn behind the head.
+    pub skybox: bool,
+    /// Linear display colour where nothing covers (skybox off).
+    pub background: [f32; 3],
+    /// The maps' UV origin: `top-left` or `bottom-left`.
+    pub uv_origin: String,
+    /// Millimetres per mesh unit (`None`: the mesh's own, or the built-in head's).
+    pub mm_per_unit: Option<f32>,
+    pub camera: CameraSetup,
 }
 
 /// Device memory at the end of the run.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema)]
 pub struct MemoryUse {
     /// Pooled transient images of the render graph.
     pub transient_pool_bytes: u64,
@@ -73,7 +119,7 @@ pub struct MemoryUse {
 pub const RULER_COPY: &str = "ruler_copy";
 
 /// One pass (or the frame span) over the measured frames.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 pub struct PassStats {
     pub name: String,
     /// Measured frames that timed it.
@@ -124,51 +170,70 @@ impl PassStats {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 pub struct RunReport {
+    /// [`SCHEMA_VERSION`] of the writer.
+    pub schema_version: u32,
     pub dermis_version: String,
     pub git_commit: String,
+    /// The binary was built from sources that differ from `git_commit`.
+    pub git_dirty: bool,
+    /// Unique per run (fingerprint::run_id): keeps concatenated CSVs apart.
+    pub run_id: String,
+    /// When the report was made, RFC 3339 UTC.
+    pub timestamp: String,
+    /// The process's arguments, the program first.
+    pub command_line: Vec<String>,
     pub setup: RunSetup,
-    pub device: String,
-    pub device_type: String,
-    pub driver: String,
-    pub api_version: String,
-    /// `LP_NUM_THREADS` (lavapipe's rasterizer thread count), when set.
-    pub lp_num_threads: Option<String>,
-    /// What measured the passes: "gpu-timestamp" or "host-fence".
-    pub clock: String,
+    /// Device, driver, CPU, threads, clock, validation.
+    pub fingerprint: Fingerprint,
     /// Output image size.
     pub width: u32,
     pub height: u32,
+    /// Independent repetitions (`--runs`), each with its own pipelines and warm-up.
+    pub runs: usize,
+    /// Frames of all runs, warm-up included.
     pub frames: usize,
+    /// Warm-up frames at the start of each run, outside the statistics.
     pub warmup_frames: usize,
     /// Same as `memory.transient_pool_bytes` (kept for older readers).
     pub transient_bytes: u64,
     pub memory: MemoryUse,
-    /// Per pass over the measured (post-warm-up) frames, in first-seen order.
+    /// Per pass over the measured (post-warm-up) frames of every run, in
+    /// first-seen order.
     pub passes: Vec<PassStats>,
     /// The frame's GPU span over the measured frames.
     pub frame_span: PassStats,
     /// Per-pass medians over the measured frames.
     pub median: Option<FrameReport>,
-    /// Passes only the warm-up frame ran: what a render computes once and keeps
-    /// (SH projection, prefiltered environment, stretch maps, shadows).
+    /// Passes only warm-up frames ran: what a render computes once and keeps
+    /// (SH projection, prefiltered environment, stretch maps, shadows), from the
+    /// first run.
     pub warmup_only: Vec<PassTime>,
     pub per_frame: Vec<FrameReport>,
 }
 
 impl RunReport {
-    /// With more than one frame the first is warm-up, outside the statistics.
+    /// `per_frame` holds every run's frames in order (`FrameReport::run`); the
+    /// first `warmup` frames of each run are warm-up, outside the statistics.
     pub fn new(
         device: &DeviceInfo,
         setup: RunSetup,
-        width: u32,
-        height: u32,
-        per_frame: Vec<FrameReport>,
+        (width, height): (u32, u32),
+        mut per_frame: Vec<FrameReport>,
+        warmup: usize,
         memory: MemoryUse,
     ) -> Self {
-        let warmup = usize::from(per_frame.len() > 1);
-        let measured = &per_frame[warmup.min(per_frame.len())..];
+        let mut seen = 0;
+        for i in 0..per_frame.len() {
+            seen = if i > 0 && per_frame[i].run == per_frame[i - 1].run {
+                seen + 1
+            } else {
+                0
+            };
+            per_frame[i].warmup = seen < warmup;
+        }
+        let measured: Vec<&FrameReport> = per_frame.iter().filter(|f| !f.warmup).collect();
         let mut names: Vec<&str> = Vec::new();
         for p in measured.iter().flat_map(|f| &f.passes) {
             if !names.contains(&p.name.as_str()) {
@@ -192,52 +257,80 @@ impl RunReport {
             p.x_ruler = p.ns_per_texel.zip(ruler).map(|(a, r)| a / r);
         }
         let spans = measured.iter().map(|f| f.gpu_frame_ns).collect();
-        let warmup_only = per_frame[..warmup]
+        let first_run = per_frame.first().map_or(0, |f| f.run);
+        let warmup_only = per_frame
             .iter()
+            .filter(|f| f.warmup && f.run == first_run)
             .flat_map(|f| &f.passes)
             .filter(|p| !names.contains(&p.name.as_str()))
             .cloned()
             .collect();
+        let measured_owned: Vec<FrameReport> = measured.into_iter().cloned().collect();
+        let mut fingerprint = Fingerprint::of(device);
+        fingerprint.clock = per_frame
+            .first()
+            .map_or_else(|| "none".into(), |f| f.clock.clone());
+        let mut runs: Vec<u32> = per_frame.iter().map(|f| f.run).collect();
+        runs.dedup();
         Self {
+            schema_version: SCHEMA_VERSION,
             dermis_version: VERSION.into(),
             git_commit: GIT_COMMIT.into(),
+            git_dirty: GIT_DIRTY,
+            run_id: run_id(),
+            timestamp: timestamp(),
+            command_line: std::env::args().collect(),
             setup,
-            device: device.name.clone(),
-            device_type: device.device_type.clone(),
-            driver: format!("{} {}", device.driver_name, device.driver_info),
-            api_version: device.api_version.clone(),
-            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
-            clock: per_frame
-                .first()
-                .map_or_else(|| "none".into(), |f| f.clock.clone()),
+            fingerprint,
             width,
             height,
+            runs: runs.len().max(1),
             frames: per_frame.len(),
             warmup_frames: warmup,
             transient_bytes: memory.transient_pool_bytes,
             memory,
             passes,
             frame_span: PassStats::of("frame (GPU span)", spans),
-            median: FrameReport::median(measured),
+            median: FrameReport::median(&measured_owned),
             warmup_only,
             per_frame,
         }
     }
 
+    /// The measured frames, every run's warm-up left out.
+    pub fn measured(&self) -> impl Iterator<Item = &FrameReport> {
+        self.per_frame.iter().filter(|f| !f.warmup)
+    }
+
+    /// Statistics that came from cold frames alone (one frame per run, no
+    /// warm-up: lavapipe compiled every shader inside it): say so.
+    pub fn cold_warning(&self) -> Option<String> {
+        (self.warmup_frames == 0 && !self.per_frame.is_empty()).then(|| {
+            "warning: no warm-up frame: the timings include shader compilation and first \
+             use; render with --frames 2 or more (the first is warm-up)"
+                .to_string()
+        })
+    }
+
     /// Three lines: the device, the setup and the post-processing.
     pub fn header(&self) -> String {
-        let s = &self.setup;
+        let (s, f) = (&self.setup, &self.fingerprint);
         format!(
-            "{} ({}), API {}, LP_NUM_THREADS={}, dermis {} ({})\n\
+            "{} ({}), API {}, CPU {} × {}, LP_NUM_THREADS={}, validation {}, dermis {} ({}{})\n\
              {} {}x{} (render {}x{}), irradiance {}², kernel {}, chain {}, occlusion {}, \
-             mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} frame(s), {} warm-up\n\
+             mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} run(s), \
+             {} frame(s), {} warm-up per run\n\
              exposure {:+.2} EV ({}), tone curve {}, glow {}, blur width {}, blur amount {}{}\n",
-            self.device,
-            self.driver.trim(),
-            self.api_version,
-            self.lp_num_threads.as_deref().unwrap_or("unset"),
+            f.device,
+            f.driver,
+            f.api_version,
+            f.cpu_model,
+            f.cpu_cores,
+            f.lp_num_threads.as_deref().unwrap_or("unset"),
+            if f.validation { "on" } else { "off" },
             self.dermis_version,
             self.git_commit,
+            if self.git_dirty { ", dirty" } else { "" },
             s.view,
             self.width,
             self.height,
@@ -252,6 +345,7 @@ impl RunReport {
             s.environment_rotation_deg,
             s.extracted_lights,
             s.environment_lights,
+            self.runs,
             self.frames,
             self.warmup_frames,
             s.exposure_ev,
@@ -278,12 +372,14 @@ impl RunReport {
         let ms = |ns: Option<f64>| ns.map_or("n/a".to_string(), |v| format!("{:.3}", v / 1e6));
         let row = |name: &str, frames: usize, t: Option<Stats>| {
             format!(
-                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6}",
+                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>6}",
                 name,
                 ms(t.map(|t| t.median_ns)),
                 ms(t.map(|t| t.min_ns)),
                 ms(t.map(|t| t.max_ns)),
                 ms(t.map(|t| t.p90_ns)),
+                ms(t.map(|t| t.mean_ns)),
+                ms(t.map(|t| t.std_ns)),
                 frames
             )
         };
@@ -291,9 +387,9 @@ impl RunReport {
             |v: Option<f64>, digits: usize| v.map_or(String::new(), |v| format!("{v:.digits$}"));
         let mut s =
             format!(
-            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>6} {:>10} {:>9} {:>7} {:>7}   (ms; clock: {})\n",
-            "pass", "median", "min", "max", "p90", "frames", "texels", "ns/texel", "GB/s", "×ruler",
-            self.clock
+            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>6} {:>10} {:>9} {:>7} {:>7}   (ms; clock: {})\n",
+            "pass", "median", "min", "max", "p90", "mean", "std", "frames", "texels", "ns/texel",
+            "GB/s", "×ruler", self.fingerprint.clock
         );
         for p in &self.passes {
             s += &format!(
@@ -317,7 +413,7 @@ impl RunReport {
             self.frame_span.time,
         );
         s.push('\n');
-        let measured = &self.per_frame[self.warmup_frames.min(self.per_frame.len())..];
+        let measured: Vec<&FrameReport> = self.measured().collect();
         for (name, v) in [
             (
                 "CPU record",
@@ -424,13 +520,21 @@ pub(super) mod tests {
     }
 
     pub fn report(a: &[f64]) -> RunReport {
-        RunReport::new(&device(), setup(), 64, 48, frames(a), MemoryUse::default())
+        let warmup = usize::from(a.len() > 1);
+        RunReport::new(
+            &device(),
+            setup(),
+            (64, 48),
+            frames(a),
+            warmup,
+            MemoryUse::default(),
+        )
     }
 
     #[test]
     fn per_texel_figures_follow_from_work_and_median() {
-        let mut s =
-            PassStats::of("p", vec![Some(2000.0), Some(4000.0), Some(3000.0)]).with_work(Some(1000), Some(6000));
+        let mut s = PassStats::of("p", vec![Some(2000.0), Some(4000.0), Some(3000.0)])
+            .with_work(Some(1000), Some(6000));
         assert_eq!(s.ns_per_texel, Some(3.0));
         assert_eq!(s.gb_per_s, Some(2.0));
         s = s.with_work(None, Some(0));
@@ -454,7 +558,7 @@ pub(super) mod tests {
         );
         assert_eq!(r.frame_span.time.unwrap().median_ns, 50.0);
         assert_eq!(r.median.as_ref().unwrap().pass_ns("a"), Some(30.0));
-        assert_eq!(r.clock, "host-fence");
+        assert_eq!(r.fingerprint.clock, "host-fence");
         let table = r.table();
         assert!(
             table.contains("p90") && table.contains("frame (GPU span)"),
@@ -471,7 +575,7 @@ pub(super) mod tests {
             gpu_ns: Some(2.5e6),
             ..Default::default()
         });
-        let r = RunReport::new(&device(), setup(), 64, 48, f, MemoryUse::default());
+        let r = RunReport::new(&device(), setup(), (64, 48), f, 1, MemoryUse::default());
         assert_eq!(r.passes.len(), 2);
         assert_eq!(r.warmup_only.len(), 1);
         let table = r.table();
@@ -492,13 +596,39 @@ pub(super) mod tests {
         assert_eq!(v["passes"][0]["median_ns"], 4.0);
         assert_eq!(v["passes"][1]["p90_ns"], 5.0);
         assert_eq!(v["per_frame"][1]["passes"][1]["start_ns"], 13.0);
+        assert_eq!(v["schema_version"], SCHEMA_VERSION);
+        assert_eq!(v["fingerprint"]["clock"], "host-fence");
+        assert_eq!(v["passes"][0]["samples_ns"], serde_json::json!([3.0, 5.0]));
+        // What is written reads back.
+        let back: RunReport = serde_json::from_value(v).unwrap();
+        assert_eq!(back.passes[0].time, report(&[7.0, 3.0, 5.0]).passes[0].time);
+    }
+
+    #[test]
+    fn runs_each_have_their_warm_up() {
+        // Two runs of three frames, warm-up 1 each: measured 10 20 | 30 40.
+        let mut f = frames(&[1000.0, 10.0, 20.0]);
+        let mut second = frames(&[2000.0, 30.0, 40.0]);
+        for x in &mut second {
+            x.run = 1;
+        }
+        f.extend(second);
+        let r = RunReport::new(&device(), setup(), (1, 1), f, 1, MemoryUse::default());
+        assert_eq!((r.runs, r.frames, r.warmup_frames), (2, 6, 1));
+        let warm: Vec<bool> = r.per_frame.iter().map(|f| f.warmup).collect();
+        assert_eq!(warm, [true, false, false, true, false, false]);
+        let a = r.passes[0].time.unwrap();
+        assert_eq!((a.median_ns, a.mean_ns), (25.0, 25.0));
+        assert_eq!(r.passes[0].frames, 4);
+        assert!(r.cold_warning().is_none());
     }
 
     #[test]
     fn a_pass_no_frame_timed_has_a_count_of_zero() {
         let mut f = frames(&[1.0]);
         f[0].passes[0].gpu_ns = None;
-        let r = RunReport::new(&device(), setup(), 1, 1, f, MemoryUse::default());
+        let r = RunReport::new(&device(), setup(), (1, 1), f, 0, MemoryUse::default());
+        assert!(r.cold_warning().is_some());
         let v = serde_json::to_value(&r.passes[0]).unwrap();
         assert_eq!(v["frames"], 0);
         assert!(v.get("median_ns").is_none(), "{v}");

@@ -1,9 +1,11 @@
-//! Order statistics of one quantity over frames: median, min, max, p90.
+//! Statistics of one quantity over frames: median, min, max, p90, mean and
+//! standard deviation.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// A quantity over several frames, in ns.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Stats {
     /// Mean of the two middle values when the count is even.
     pub median_ns: f64,
@@ -11,6 +13,12 @@ pub struct Stats {
     pub max_ns: f64,
     /// Nearest rank: the smallest value at least 90 % of the values do not exceed.
     pub p90_ns: f64,
+    /// Arithmetic mean (0 in reports older than schema 2).
+    #[serde(default)]
+    pub mean_ns: f64,
+    /// Sample standard deviation (n − 1); 0 for one value.
+    #[serde(default)]
+    pub std_ns: f64,
 }
 
 impl Stats {
@@ -21,11 +29,15 @@ impl Stats {
         if n == 0 {
             return None;
         }
+        let mean = v.iter().sum::<f64>() / n as f64;
+        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n.max(2) - 1) as f64;
         Some(Stats {
             median_ns: median_of_sorted(&v),
             min_ns: v[0],
             max_ns: v[n - 1],
             p90_ns: v[(9 * n).div_ceil(10) - 1],
+            mean_ns: mean,
+            std_ns: var.sqrt(),
         })
     }
 }
@@ -64,7 +76,10 @@ mod tests {
                 median_ns: 5.0,
                 min_ns: 1.0,
                 max_ns: 9.0,
-                p90_ns: 9.0
+                p90_ns: 9.0,
+                mean_ns: 5.0,
+                // Σ (x − 5)² = 40 over n − 1 = 4.
+                std_ns: 10f64.sqrt(),
             }
         );
     }
@@ -88,6 +103,7 @@ mod tests {
     fn one_value_empty_and_non_finite() {
         let s = Stats::of(&[42.0]).unwrap();
         assert_eq!([s.median_ns, s.min_ns, s.max_ns, s.p90_ns], [42.0; 4]);
+        assert_eq!((s.mean_ns, s.std_ns), (42.0, 0.0));
         assert_eq!(Stats::of(&[]), None);
         assert_eq!(Stats::of(&[f64::NAN]), None);
         assert_eq!(median(&[2.0, f64::INFINITY, 4.0]), Some(3.0));

@@ -27,7 +27,7 @@ pub fn trace(report: &RunReport) -> Value {
     let tid = |clock: &str| clocks.iter().position(|c| *c == clock).unwrap_or(0) + 1;
     let mut events = vec![json!({
         "name": "process_name", "ph": "M", "pid": PID, "tid": 0,
-        "args": { "name": format!("dermis {} ({}) on {}", report.dermis_version, report.git_commit, report.device) },
+        "args": { "name": format!("dermis {} ({}) on {}", report.dermis_version, report.git_commit, report.fingerprint.device) },
     })];
     for c in &clocks {
         let name = match *c {
@@ -44,8 +44,13 @@ pub fn trace(report: &RunReport) -> Value {
     let mut slices = Vec::new();
     let mut cursor = 0.0f64;
     let mut run_end = 0.0f64;
-    for f in &report.per_frame {
-        let start = f.start_ns.unwrap_or(cursor);
+    // Each run's clock starts again at 0: runs follow one another.
+    let mut run_base = 0.0f64;
+    for (i, f) in report.per_frame.iter().enumerate() {
+        if i > 0 && f.run != report.per_frame[i - 1].run {
+            run_base = run_end;
+        }
+        let start = f.start_ns.map_or(cursor, |s| run_base + s);
         let pass_end = f
             .passes
             .iter()
@@ -54,13 +59,12 @@ pub fn trace(report: &RunReport) -> Value {
         let span = f.gpu_frame_ns.unwrap_or(pass_end);
         cursor = start + span;
         run_end = run_end.max(cursor);
-        let warmup = (f.frame as usize) < report.warmup_frames;
         let (ts, dur) = ts_dur(start, start + span);
         slices.push(json!({
-            "name": format!("frame {}", f.frame), "cat": "frame", "ph": "X",
+            "name": format!("run {} frame {}", f.run, f.frame), "cat": "frame", "ph": "X",
             "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur,
             "args": {
-                "frame": f.frame, "warmup": warmup,
+                "run": f.run, "frame": f.frame, "warmup": f.warmup,
                 "cpu_record_ns": f.cpu_record_ns, "cpu_submit_ns": f.cpu_submit_ns,
             },
         }));
@@ -72,7 +76,7 @@ pub fn trace(report: &RunReport) -> Value {
             slices.push(json!({
                 "name": p.name, "cat": "pass", "ph": "X",
                 "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur_us,
-                "args": { "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur },
+                "args": { "run": f.run, "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur },
             }));
         }
     }
@@ -83,11 +87,12 @@ pub fn trace(report: &RunReport) -> Value {
             "ts": 0.0, "dur": ts_dur(0.0, run_end).1,
             "args": {
                 "dermis_version": report.dermis_version, "git_commit": report.git_commit,
-                "device": report.device, "driver": report.driver, "clock": report.clock,
+                "fingerprint": report.fingerprint, "run_id": report.run_id,
                 "scene": s.scene, "mesh": s.mesh, "environment": s.environment,
                 "irradiance_resolution": s.irradiance_resolution, "kernel": s.kernel,
                 "chain": s.chain, "view": s.view, "occlusion": s.occlusion,
                 "width": report.width, "height": report.height, "frames": report.frames,
+                "runs": report.runs,
             },
         }));
     }

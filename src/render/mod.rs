@@ -20,9 +20,9 @@ use crate::light::reference::{render_view, ReferenceImage, Settings as Reference
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::profile::{MemoryUse, RunReport, RunSetup};
+use crate::profile::{CameraSetup, MemoryUse, RunReport, RunSetup};
 use crate::scene::checker;
-use crate::scene::file::{Chain, Kernel, Occlusion, UvOrigin};
+use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
@@ -46,6 +46,26 @@ pub struct RenderOptions {
     pub progress: bool,
     /// Time the rulers (render::ruler) in every frame.
     pub ruler: bool,
+    /// Independent repetitions, each with a fresh upload, pipelines and warm-up;
+    /// the image is the last run's.
+    pub runs: u32,
+    /// Warm-up frames per run, outside the statistics (`None`: 1 when there
+    /// are more frames than one, else 0).
+    pub warmup: Option<u32>,
+}
+
+impl RenderOptions {
+    /// Warm-up frames per run; an error when no measured frame would be left.
+    pub fn warmup_frames(&self) -> Result<u32> {
+        match self.warmup {
+            None => Ok(u32::from(self.frames > 1)),
+            Some(w) if w < self.frames => Ok(w),
+            Some(w) => Err(Error::Input(format!(
+                "--warmup {w} leaves none of --frames {} measured: give more frames than warm-up",
+                self.frames
+            ))),
+        }
+    }
 }
 
 impl Default for RenderOptions {
@@ -57,6 +77,8 @@ impl Default for RenderOptions {
             scene_path: None,
             progress: false,
             ruler: false,
+            runs: 1,
+            warmup: None,
         }
     }
 }
@@ -115,6 +137,26 @@ fn setup(
         blur_width: f.skin.blur_width,
         blur_amount: f.skin.blur_amount,
         test_texture: f.textures.test_texture || view == View::TestTexture,
+        gamma: match f.render.gamma {
+            Gamma::Srgb => "srgb".into(),
+            Gamma::Power(g) => g.to_string(),
+        },
+        skybox: f.render.skybox,
+        background: f.render.background,
+        uv_origin: match f.textures.uv_origin {
+            UvOrigin::TopLeft => "top-left",
+            UvOrigin::BottomLeft => "bottom-left",
+        }
+        .into(),
+        mm_per_unit: f.mm_per_unit,
+        camera: CameraSetup {
+            position_mm: scene.camera.position.into(),
+            target_mm: scene.camera.target.into(),
+            up: scene.camera.up.into(),
+            fov_y_deg: scene.camera.fov_y_deg,
+            near_mm: scene.camera.near_mm,
+            far_mm: scene.camera.far_mm,
+        },
     }
 }
 
@@ -159,11 +201,14 @@ pub fn render_scene(
     scene: &Scene,
     opts: &RenderOptions,
 ) -> Result<RenderOutput> {
-    if opts.frames == 0 {
-        return Err(Error::Input(
-            "frames: 0 frames render nothing; give 1 or more".into(),
-        ));
+    for (n, what) in [(opts.frames, "frames"), (opts.runs, "runs")] {
+        if n == 0 {
+            return Err(Error::Input(format!(
+                "{what}: 0 {what} render nothing; give 1 or more"
+            )));
+        }
     }
+    let warmup = opts.warmup_frames()?;
     let skin = settings(ctx, scene)?;
     if opts.view == View::Reference {
         return reference(ctx, scene, opts);
@@ -175,8 +220,28 @@ pub fn render_scene(
     } else {
         &scene.albedo
     };
-    let frame = Frame::new(ctx, scene, albedo, skin, opts.ruler)?;
-    run(ctx, scene, &frame, opts.view, opts)
+    let mut frames = Vec::new();
+    let mut last = None;
+    for run_index in 0..opts.runs {
+        let frame = Frame::new(ctx, scene, albedo, skin.clone(), opts.ruler)?;
+        let out = run(ctx, scene, &frame, opts.view, opts)?;
+        frames.extend(out.report.per_frame.iter().cloned().map(|mut f| {
+            f.run = run_index;
+            f
+        }));
+        last = Some(out);
+    }
+    let mut out = last.expect("at least one run");
+    let r = &out.report;
+    out.report = RunReport::new(
+        &ctx.info,
+        r.setup.clone(),
+        (r.width, r.height),
+        frames,
+        warmup as usize,
+        r.memory,
+    );
+    Ok(out)
 }
 
 /// The skin settings of `scene`, its sizes checked against the device.
@@ -363,7 +428,8 @@ fn run(
         frame.extracted.len(),
         (ev, metered.is_some()),
     );
-    let report = RunReport::new(&ctx.info, run_setup, w, h, reports, memory);
+    let warmup = opts.warmup_frames()? as usize;
+    let report = RunReport::new(&ctx.info, run_setup, (w, h), reports, warmup, memory);
     Ok(RenderOutput {
         width: w,
         height: h,
@@ -403,7 +469,14 @@ fn reference(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<
         hdr,
         exposure: ev,
         metered,
-        report: RunReport::new(&ctx.info, setup, w, h, Vec::new(), MemoryUse::default()),
+        report: RunReport::new(
+            &ctx.info,
+            setup,
+            (w, h),
+            Vec::new(),
+            0,
+            MemoryUse::default(),
+        ),
         plan: String::new(),
     })
 }

@@ -1,0 +1,959 @@
+//! `dermis compare`: whether a pass got slower between two measurements, with
+//! criterion.rs's rule — a change counts only when it is significant (Mann-
+//! Whitney U, Holm-corrected over the passes) **and** its whole bootstrap
+//! confidence interval lies beyond the noise threshold — and Chromium
+//! Pinpoint's third answer: inconclusive, measure more (with how much more).
+//!
+//! Times are compared in ruler units where both sides timed the ruler (each
+//! frame's pass time over the same frame's `ruler_copy`), so that a busy
+//! machine, which slows both, cancels; else in ms.
+
+use super::bootstrap::relative_change_ci;
+use super::fingerprint::Fingerprint;
+use super::run::{RunReport, RULER_COPY, SCHEMA_VERSION};
+use super::significance::{holm, mann_whitney_p, smallest_p};
+use super::stats::median;
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The default noise threshold: the relative change below which a difference
+/// is not reported, from A/A runs on lavapipe (docs/performance.md, "Comparing
+/// runs": the 95th percentile of |change| between two sets of 10 identical
+/// runs).
+pub const DEFAULT_NOISE_THRESHOLD: f64 = 0.03;
+/// Significance level of the Holm-corrected test (criterion.rs's default).
+pub const DEFAULT_SIGNIFICANCE: f64 = 0.05;
+/// Confidence level of the bootstrap interval.
+pub const CONFIDENCE: f64 = 0.95;
+/// The row of each frame's passes summed (rulers excluded).
+pub const FRAME_ROW: &str = "frame (sum of passes)";
+
+/// Setup keys whose difference changes the work itself: timings of such runs
+/// measure different things (an error unless allowed).
+const WORKLOAD_KEYS: [&str; 6] = [
+    "scene",
+    "mesh",
+    "view",
+    "render_width",
+    "render_height",
+    "irradiance_resolution",
+];
+/// Setup keys that vary between identical runs (the metered exposure).
+const RUN_KEYS: [&str; 1] = ["exposure_ev"];
+
+/// One side of a comparison: the measured (post-warm-up) frames of one or
+/// more runs, and where they were measured.
+#[derive(Clone, Debug, Default)]
+pub struct Measurement {
+    /// The files it was read from.
+    pub source: String,
+    pub fingerprint: Fingerprint,
+    /// The setup as key → value text (RunSetup's JSON fields).
+    pub setup: BTreeMap<String, String>,
+    /// Pass names in first-seen order.
+    pub pass_order: Vec<String>,
+    /// Texels each pass computes (for × ruler).
+    pub texels: BTreeMap<String, u64>,
+    pub frames: Vec<MeasuredFrame>,
+}
+
+/// One measured frame: its run (a key unique across pooled reports) and
+/// each pass's time in ns.
+#[derive(Clone, Debug, Default)]
+pub struct MeasuredFrame {
+    pub run: String,
+    pub passes: BTreeMap<String, f64>,
+}
+
+impl Measurement {
+    /// The measured frames of a run report (schema 2 or later).
+    pub fn from_report(report: &RunReport, source: &str) -> Result<Self> {
+        if report.schema_version < 2 {
+            return Err(Error::Input(format!(
+                "{source}: report schema {} is older than 2 (no fingerprint): render it again",
+                report.schema_version
+            )));
+        }
+        let setup = flat_setup(&report.setup)?;
+        let frames = report
+            .measured()
+            .map(|f| MeasuredFrame {
+                run: format!("{}#{}", report.run_id, f.run),
+                passes: first_of_each(f),
+            })
+            .collect();
+        Ok(Self {
+            source: source.to_string(),
+            fingerprint: report.fingerprint.clone(),
+            setup,
+            pass_order: report.passes.iter().map(|p| p.name.clone()).collect(),
+            texels: report
+                .passes
+                .iter()
+                .filter_map(|p| Some((p.name.clone(), p.texels?)))
+                .collect(),
+            frames,
+        })
+    }
+
+    /// Reads a report (`--report FILE.json`) from its JSON text.
+    pub fn from_report_json(text: &str, source: &str) -> Result<Self> {
+        let value: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| Error::Input(format!("{source}: not JSON: {e}")))?;
+        let version = value.get("schema_version").and_then(|v| v.as_u64());
+        match version {
+            Some(v) if v > u64::from(SCHEMA_VERSION) => {
+                return Err(Error::Input(format!(
+                    "{source}: report schema {v} is newer than this dermis reads ({SCHEMA_VERSION})"
+                )))
+            }
+            None if value.get("per_frame").is_some() => {
+                return Err(Error::Input(format!(
+                    "{source}: a report older than schema 2 (no fingerprint): render it again"
+                )))
+            }
+            None => {
+                return Err(Error::Input(format!(
+                    "{source}: not a dermis run report (no schema_version)"
+                )))
+            }
+            _ => {}
+        }
+        let report: RunReport = serde_json::from_value(value)
+            .map_err(|e| Error::Input(format!("{source}: not a dermis run report: {e}")))?;
+        Self::from_report(&report, source)
+    }
+
+    /// Several measurements of one configuration as one (e.g. one report per
+    /// process of an interleaved run): setups must agree; differing machines
+    /// are returned as warnings.
+    pub fn pool(parts: Vec<Measurement>) -> Result<(Self, Vec<String>)> {
+        let mut parts = parts.into_iter();
+        let mut all = parts
+            .next()
+            .ok_or_else(|| Error::Input("no measurement to pool".into()))?;
+        let mut warnings = Vec::new();
+        for m in parts {
+            let diff = setup_differences(&all.setup, &m.setup);
+            if !diff.is_empty() {
+                return Err(Error::Input(format!(
+                    "{} and {} were rendered with different setups ({}): pool only runs of one setup",
+                    all.source,
+                    m.source,
+                    diff.join(", ")
+                )));
+            }
+            for d in all.fingerprint.differences(&m.fingerprint) {
+                warnings.push(format!("{} vs {}: {d}", all.source, m.source));
+            }
+            for p in &m.pass_order {
+                if !all.pass_order.contains(p) {
+                    all.pass_order.push(p.clone());
+                }
+            }
+            all.texels.extend(m.texels);
+            all.frames.extend(m.frames);
+            all.source = format!("{}, {}", all.source, m.source);
+        }
+        Ok((all, warnings))
+    }
+
+    fn runs(&self) -> usize {
+        let mut runs: Vec<&str> = self.frames.iter().map(|f| f.run.as_str()).collect();
+        runs.sort_unstable();
+        runs.dedup();
+        runs.len()
+    }
+
+    fn has_ruler(&self) -> bool {
+        !self.frames.is_empty()
+            && self
+                .frames
+                .iter()
+                .all(|f| f.passes.contains_key(RULER_COPY))
+    }
+}
+
+/// Each pass's time in a frame; of two passes of one name the first, as the
+/// report's statistics take it (FrameReport::pass_ns).
+fn first_of_each(f: &super::FrameReport) -> BTreeMap<String, f64> {
+    let mut out = BTreeMap::new();
+    for p in &f.passes {
+        if let Some(ns) = p.gpu_ns.filter(|v| v.is_finite()) {
+            out.entry(p.name.clone()).or_insert(ns);
+        }
+    }
+    out
+}
+
+/// The setup's fields as text, for comparing setups.
+fn flat_setup(setup: &impl Serialize) -> Result<BTreeMap<String, String>> {
+    let value = serde_json::to_value(setup).map_err(|e| Error::Input(e.to_string()))?;
+    let mut out = BTreeMap::new();
+    if let serde_json::Value::Object(map) = value {
+        for (k, v) in map {
+            let text = match v {
+                serde_json::Value::String(s) => s,
+                other => other.to_string(),
+            };
+            out.insert(k, text);
+        }
+    }
+    Ok(out)
+}
+
+/// "kernel: deon7 → accurate" per differing key (run-to-run keys left out).
+fn setup_differences(a: &BTreeMap<String, String>, b: &BTreeMap<String, String>) -> Vec<String> {
+    let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+    keys.into_iter()
+        .filter(|k| !RUN_KEYS.contains(&k.as_str()))
+        .filter_map(|k| {
+            let (x, y) = (a.get(k), b.get(k));
+            (x != y).then(|| {
+                format!(
+                    "{k}: {} → {}",
+                    x.map_or("–", String::as_str),
+                    y.map_or("–", String::as_str)
+                )
+            })
+        })
+        .collect()
+}
+
+/// What a pass's time is measured in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Unit {
+    /// Ruler units where they scatter less than ms between samples (each
+    /// side's own scatter, judged before comparing), else ms.
+    Auto,
+    /// Each pass over the ruler of its frame (or run): a busier machine cancels.
+    Ruler,
+    Ms,
+}
+
+/// Coefficient of variation (sample standard deviation over the mean).
+fn scatter(v: &[f64]) -> Option<f64> {
+    let n = v.len();
+    if n < 2 {
+        return None;
+    }
+    let mean = v.iter().sum::<f64>() / n as f64;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    (mean > 0.0).then(|| var.sqrt() / mean)
+}
+
+/// How to decide.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CompareOptions {
+    pub unit: Unit,
+    /// Relative change below which nothing is reported (0.03 = 3 %).
+    pub noise_threshold: f64,
+    /// Family-wise significance level (Holm over the passes).
+    pub significance: f64,
+    /// Compare runs whose work differs (scene, view, sizes).
+    pub allow_setup_change: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        Self {
+            unit: Unit::Auto,
+            noise_threshold: DEFAULT_NOISE_THRESHOLD,
+            significance: DEFAULT_SIGNIFICANCE,
+            allow_setup_change: false,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    Regressed,
+    Improved,
+    Unchanged,
+    /// The interval straddles the threshold, or too few samples to be
+    /// significant: measure more.
+    Inconclusive,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Regressed => "regressed",
+            Verdict::Improved => "improved",
+            Verdict::Unchanged => "unchanged",
+            Verdict::Inconclusive => "inconclusive",
+        }
+    }
+}
+
+/// One pass's comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassChange {
+    pub name: String,
+    /// "ruler" (each frame over its ruler) or "ms".
+    pub unit: &'static str,
+    /// "run" (each run's median is one sample) or "frame".
+    pub sample: &'static str,
+    pub base_samples: usize,
+    pub new_samples: usize,
+    pub base_ms: Option<f64>,
+    pub new_ms: Option<f64>,
+    /// Median ns/texel as a multiple of the ruler's, where known.
+    pub base_x_ruler: Option<f64>,
+    pub new_x_ruler: Option<f64>,
+    /// median(new) / median(base) − 1 in `unit`.
+    pub change: Option<f64>,
+    /// The same in ms (informative where `unit` is the ruler).
+    pub change_ms: Option<f64>,
+    pub ci_low: Option<f64>,
+    pub ci_high: Option<f64>,
+    pub p: f64,
+    /// Holm-adjusted over the compared passes (rulers are not in the family).
+    pub p_holm: f64,
+    pub verdict: Verdict,
+    /// A ruler pass: shown, not judged.
+    pub ruler: bool,
+    /// For an inconclusive pass: about how many more samples per side would
+    /// decide it; `None` where no number would (the change sits on the threshold).
+    pub more_samples: Option<usize>,
+}
+
+/// Two measurements compared pass by pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    pub base: String,
+    pub new: String,
+    pub options: CompareOptions,
+    /// Fingerprint differences, pooled-run differences, sample-size notes.
+    pub warnings: Vec<String>,
+    /// Setup keys that differ (the change under test, if meant).
+    pub setup_changes: Vec<String>,
+    pub passes: Vec<PassChange>,
+    pub only_in_base: Vec<String>,
+    pub only_in_new: Vec<String>,
+}
+
+impl Comparison {
+    pub fn count(&self, verdict: Verdict) -> usize {
+        self.passes
+            .iter()
+            .filter(|p| !p.ruler && p.verdict == verdict)
+            .count()
+    }
+
+    pub fn regressed(&self) -> bool {
+        self.count(Verdict::Regressed) > 0
+    }
+}
+
+/// Compares `new` with `base`.
+pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> Result<Comparison> {
+    if !(opts.noise_threshold >= 0.0 && opts.noise_threshold < 1.0) {
+        return Err(Error::Input(format!(
+            "--noise-threshold {}: give a fraction in [0, 1) (0.03 = 3 %)",
+            opts.noise_threshold
+        )));
+    }
+    if !(opts.significance > 0.0 && opts.significance < 1.0) {
+        return Err(Error::Input(format!(
+            "--significance {}: give a level in (0, 1)",
+            opts.significance
+        )));
+    }
+    for m in [base, new] {
+        if m.frames.is_empty() {
+            return Err(Error::Input(format!(
+                "{}: no measured frames (render with --frames 2 or more: the first is warm-up)",
+                m.source
+            )));
+        }
+    }
+    let (fb, fnew) = (&base.fingerprint, &new.fingerprint);
+    if fb.clock != fnew.clock {
+        return Err(Error::Input(format!(
+            "{} was timed by {} and {} by {}: the clocks measure different spans",
+            base.source, fb.clock, new.source, fnew.clock
+        )));
+    }
+    let mut warnings: Vec<String> = fb
+        .differences(fnew)
+        .into_iter()
+        .map(|d| format!("different machine or settings: {d}"))
+        .collect();
+    let setup_changes = setup_differences(&base.setup, &new.setup);
+    let workload: Vec<&String> = setup_changes
+        .iter()
+        .filter(|c| {
+            WORKLOAD_KEYS
+                .iter()
+                .any(|k| c.starts_with(&format!("{k}:")))
+        })
+        .collect();
+    if !workload.is_empty() && !opts.allow_setup_change {
+        return Err(Error::Input(format!(
+            "{} and {} rendered different work ({}): their timings do not compare \
+             (--allow-setup-change to compare anyway)",
+            base.source,
+            new.source,
+            workload
+                .iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    let by_run = base.runs() >= 2 && new.runs() >= 2;
+    if !by_run {
+        warnings.push(format!(
+            "one run on a side ({} vs {}): frames of one process share its state; \
+             use render --runs or dermis interleave for repetitions",
+            base.runs(),
+            new.runs()
+        ));
+    }
+    let has_ruler = base.has_ruler() && new.has_ruler();
+    let common: Vec<&String> = base
+        .pass_order
+        .iter()
+        .filter(|n| new.pass_order.contains(n) && !n.starts_with("ruler_"))
+        .collect();
+    let ruler = match opts.unit {
+        Unit::Ms => false,
+        Unit::Ruler if !has_ruler => {
+            return Err(Error::Input(
+                "--unit ruler: both sides need the ruler (render --ruler)".into(),
+            ))
+        }
+        Unit::Ruler => true,
+        Unit::Auto if !has_ruler => {
+            warnings.push(
+                "no ruler on both sides (render --ruler): changes are in ms, and a busier \
+                 machine moves them"
+                    .into(),
+            );
+            false
+        }
+        // Decided on each side's own scatter, before anything is compared.
+        Unit::Auto => {
+            let spread = |in_ruler: bool| {
+                let cv: Vec<f64> = common
+                    .iter()
+                    .flat_map(|n| [base, new].map(|m| scatter(&samples(m, n, in_ruler, by_run))))
+                    .flatten()
+                    .collect();
+                median(&cv).unwrap_or(f64::INFINITY)
+            };
+            let (in_ruler, in_ms) = (spread(true), spread(false));
+            if in_ruler >= in_ms {
+                warnings.push(format!(
+                    "the ruler does not steady these timings (scatter {:.1} % over the ruler, \
+                     {:.1} % in ms): compared in ms",
+                    100.0 * in_ruler,
+                    100.0 * in_ms
+                ));
+            }
+            in_ruler < in_ms
+        }
+    };
+    let mut names: Vec<String> = base
+        .pass_order
+        .iter()
+        .filter(|n| new.pass_order.contains(n))
+        .cloned()
+        .collect();
+    names.push(FRAME_ROW.into());
+    let only_in_base = only(&base.pass_order, &new.pass_order);
+    let only_in_new = only(&new.pass_order, &base.pass_order);
+
+    let mut rows: Vec<PassChange> = names
+        .iter()
+        .map(|name| {
+            let is_ruler = name.starts_with("ruler_");
+            let in_ruler = ruler && !is_ruler;
+            let (b, n) = (
+                samples(base, name, in_ruler, by_run),
+                samples(new, name, in_ruler, by_run),
+            );
+            let (b_ms, n_ms) = (
+                samples(base, name, false, by_run),
+                samples(new, name, false, by_run),
+            );
+            let ci = relative_change_ci(&b, &n, CONFIDENCE);
+            let ms = |v: &[f64]| median(v).map(|x| x / 1e6);
+            // ns/texel over the ruler's: the per-frame ratio scaled by the texels.
+            let x_ruler = |m: &Measurement| {
+                let t = *m.texels.get(name)? as f64;
+                let r = *m.texels.get(RULER_COPY)? as f64;
+                let ratio = median(&samples(m, name, true, by_run)).filter(|_| ruler)?;
+                Some(ratio * r / t)
+            };
+            PassChange {
+                name: name.clone(),
+                unit: if in_ruler { "ruler" } else { "ms" },
+                sample: if by_run { "run" } else { "frame" },
+                base_samples: b.len(),
+                new_samples: n.len(),
+                base_ms: ms(&b_ms),
+                new_ms: ms(&n_ms),
+                base_x_ruler: x_ruler(base),
+                new_x_ruler: x_ruler(new),
+                change: ci.map(|c| c.0),
+                change_ms: median(&n_ms)
+                    .zip(median(&b_ms).filter(|&v| v > 0.0))
+                    .map(|(n, b)| n / b - 1.0),
+                ci_low: ci.map(|c| c.1),
+                ci_high: ci.map(|c| c.2),
+                p: mann_whitney_p(&b, &n),
+                p_holm: 1.0,
+                verdict: Verdict::Inconclusive,
+                ruler: is_ruler,
+                more_samples: None,
+            }
+        })
+        .collect();
+    // Holm over the judged rows; rulers are corrected on their own.
+    for rulers in [false, true] {
+        let idx: Vec<usize> = (0..rows.len())
+            .filter(|&i| rows[i].ruler == rulers)
+            .collect();
+        let adj = holm(&idx.iter().map(|&i| rows[i].p).collect::<Vec<_>>());
+        for (&i, a) in idx.iter().zip(adj) {
+            rows[i].p_holm = a;
+        }
+    }
+    let family = rows.iter().filter(|r| !r.ruler).count().max(1);
+    for r in &mut rows {
+        decide(r, opts, family);
+    }
+    Ok(Comparison {
+        base: base.source.clone(),
+        new: new.source.clone(),
+        options: *opts,
+        warnings,
+        setup_changes,
+        passes: rows,
+        only_in_base,
+        only_in_new,
+    })
+}
+
+fn only(a: &[String], b: &[String]) -> Vec<String> {
+    a.iter().filter(|n| !b.contains(n)).cloned().collect()
+}
+
+/// A pass's samples: per frame, or per run (the median of its frames), in ns
+/// or over the ruler — per frame the same frame's ruler; per run the run's
+/// median ruler, which is steadier than any one frame's. `FRAME_ROW` sums the
+/// non-ruler passes.
+fn samples(m: &Measurement, name: &str, in_ruler: bool, by_run: bool) -> Vec<f64> {
+    let ns = |f: &MeasuredFrame| -> Option<f64> {
+        if name == FRAME_ROW {
+            let v: f64 = f
+                .passes
+                .iter()
+                .filter(|(n, _)| !n.starts_with("ruler_"))
+                .map(|(_, v)| v)
+                .sum();
+            (v > 0.0).then_some(v)
+        } else {
+            f.passes.get(name).copied()
+        }
+    };
+    let ruler = |f: &MeasuredFrame| f.passes.get(RULER_COPY).copied().filter(|&r| r > 0.0);
+    if !by_run {
+        return m
+            .frames
+            .iter()
+            .filter_map(|f| match in_ruler {
+                true => Some(ns(f)? / ruler(f)?),
+                false => ns(f),
+            })
+            .collect();
+    }
+    let mut runs: Vec<&str> = Vec::new();
+    for f in &m.frames {
+        if !runs.contains(&f.run.as_str()) {
+            runs.push(&f.run);
+        }
+    }
+    runs.iter()
+        .filter_map(|run| {
+            let frames = m.frames.iter().filter(|f| f.run == *run);
+            let time = median(&frames.clone().filter_map(ns).collect::<Vec<_>>())?;
+            match in_ruler {
+                true => Some(time / median(&frames.filter_map(ruler).collect::<Vec<_>>())?),
+                false => Some(time),
+            }
+        })
+        .collect()
+}
+
+/// criterion.rs's rule, with Pinpoint's "inconclusive".
+fn decide(r: &mut PassChange, opts: &CompareOptions, family: usize) {
+    let t = opts.noise_threshold;
+    let (Some(est), Some(lo), Some(hi)) = (r.change, r.ci_low, r.ci_high) else {
+        r.verdict = Verdict::Inconclusive;
+        return;
+    };
+    let significant = r.p_holm < opts.significance;
+    r.verdict = if significant && lo > t {
+        Verdict::Regressed
+    } else if significant && hi < -t {
+        Verdict::Improved
+    } else if lo >= -t && hi <= t {
+        Verdict::Unchanged
+    } else {
+        Verdict::Inconclusive
+    };
+    if r.verdict != Verdict::Inconclusive {
+        return;
+    }
+    // The interval shrinks as 1/√n: the n at which it would clear the
+    // threshold on the side the estimate is on, and at which the exact test
+    // could reach the corrected level.
+    let n = r.base_samples.min(r.new_samples).max(1);
+    let half = (hi - lo) / 2.0;
+    let margin = (est.abs() - t).abs();
+    if margin < 0.1 * t.max(1e-3) {
+        r.more_samples = None;
+        return;
+    }
+    let mut needed = (n as f64 * (half / margin).powi(2)).ceil() as usize;
+    if est.abs() > t {
+        let per_test = opts.significance / family as f64;
+        let mut k = n.max(2);
+        while smallest_p(k) >= per_test && k < 1000 {
+            k += 1;
+        }
+        needed = needed.max(k);
+    }
+    r.more_samples = Some(needed.saturating_sub(n).clamp(1, 100_000));
+}
+
+/// The comparison as a fixed-width table, then the verdicts' counts.
+pub fn table(c: &Comparison) -> String {
+    let pct = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:+.1}%", 100.0 * v));
+    let ms = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.3}"));
+    let p = |v: f64| {
+        if v >= 1e-3 {
+            format!("{v:.3}")
+        } else {
+            format!("{v:.1e}")
+        }
+    };
+    let xr = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.2}"));
+    let mut s = format!("base: {}\nnew:  {}\n", c.base, c.new);
+    for w in &c.warnings {
+        s += &format!("warning: {w}\n");
+    }
+    if !c.setup_changes.is_empty() {
+        s += &format!("setup changed: {}\n", c.setup_changes.join(", "));
+    }
+    s += &format!(
+        "{:<24} {:>10} {:>10} {:>7} {:>7} {:>8} {:>19} {:>9} {:>9}  {}\n",
+        "pass",
+        "base ms",
+        "new ms",
+        "base×r",
+        "new×r",
+        "change",
+        "95% CI",
+        "p",
+        "p (Holm)",
+        "verdict"
+    );
+    for r in &c.passes {
+        let ci = match (r.ci_low, r.ci_high) {
+            (Some(a), Some(b)) => format!("[{}, {}]", pct(Some(a)), pct(Some(b))),
+            _ => "n/a".into(),
+        };
+        let verdict = if r.ruler {
+            format!("({}, ruler, ms)", r.verdict.name())
+        } else {
+            match (r.verdict, r.more_samples) {
+                (Verdict::Inconclusive, Some(k)) => {
+                    format!("inconclusive: ~{k} more {}s per side", r.sample)
+                }
+                (Verdict::Inconclusive, None) => {
+                    "inconclusive: the change sits on the threshold".into()
+                }
+                (v, _) => v.name().to_string(),
+            }
+        };
+        s += &format!(
+            "{:<24} {:>10} {:>10} {:>7} {:>7} {:>8} {:>19} {:>9} {:>9}  {}\n",
+            r.name,
+            ms(r.base_ms),
+            ms(r.new_ms),
+            xr(r.base_x_ruler),
+            xr(r.new_x_ruler),
+            pct(r.change),
+            ci,
+            p(r.p),
+            p(r.p_holm),
+            verdict
+        );
+    }
+    let unit = if c.passes.iter().any(|r| r.unit == "ruler") {
+        "ruler units"
+    } else {
+        "ms"
+    };
+    let sample = c.passes.first().map_or("frame", |r| r.sample);
+    s += &format!(
+        "{} regressed, {} improved, {} unchanged, {} inconclusive (change in {unit}, \
+         one sample per {sample}; threshold ±{:.1} %, α = {} Holm-corrected)\n",
+        c.count(Verdict::Regressed),
+        c.count(Verdict::Improved),
+        c.count(Verdict::Unchanged),
+        c.count(Verdict::Inconclusive),
+        100.0 * c.options.noise_threshold,
+        c.options.significance
+    );
+    for (side, names) in [("base", &c.only_in_base), ("new", &c.only_in_new)] {
+        if !names.is_empty() {
+            s += &format!("only in {side}: {}\n", names.join(", "));
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A measurement of `runs` runs × `frames` frames of pass "blur" at
+    /// `ns(run, frame)` and a ruler at 1000 ns × `load(run, frame)`, where
+    /// blur is scaled by the same load.
+    fn measurement(
+        runs: usize,
+        frames: usize,
+        blur: impl Fn(usize, usize) -> f64,
+        load: impl Fn(usize, usize) -> f64,
+    ) -> Measurement {
+        let mut m = Measurement {
+            source: "m".into(),
+            pass_order: vec!["blur".into(), "skin".into(), RULER_COPY.into()],
+            ..Default::default()
+        };
+        for r in 0..runs {
+            for f in 0..frames {
+                let l = load(r, f);
+                m.frames.push(MeasuredFrame {
+                    run: format!("run{r}"),
+                    passes: [
+                        ("blur".to_string(), blur(r, f) * l),
+                        ("skin".to_string(), 5000.0 * l),
+                        (RULER_COPY.to_string(), 1000.0 * l),
+                    ]
+                    .into(),
+                });
+            }
+        }
+        m
+    }
+
+    /// Deterministic noise in [−1, 1).
+    fn noise(i: usize) -> f64 {
+        let x = (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11;
+        (x as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    fn row<'a>(c: &'a Comparison, name: &str) -> &'a PassChange {
+        c.passes.iter().find(|p| p.name == name).unwrap()
+    }
+
+    #[test]
+    fn identical_distributions_are_unchanged() {
+        let a = measurement(
+            10,
+            5,
+            |r, f| 3000.0 * (1.0 + 0.005 * noise(r * 7 + f)),
+            |_, _| 1.0,
+        );
+        let b = measurement(
+            10,
+            5,
+            |r, f| 3000.0 * (1.0 + 0.005 * noise(r * 7 + f + 100)),
+            |_, _| 1.0,
+        );
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        let blur = row(&c, "blur");
+        assert_eq!(blur.verdict, Verdict::Unchanged, "{}", table(&c));
+        assert_eq!(blur.sample, "run");
+        assert!(!c.regressed());
+    }
+
+    #[test]
+    fn a_twenty_percent_shift_is_a_regression_bracketed_by_its_interval() {
+        let a = measurement(
+            10,
+            5,
+            |r, f| 3000.0 * (1.0 + 0.01 * noise(r * 7 + f)),
+            |_, _| 1.0,
+        );
+        let b = measurement(
+            10,
+            5,
+            |r, f| 3600.0 * (1.0 + 0.01 * noise(r * 7 + f + 50)),
+            |_, _| 1.0,
+        );
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        let blur = row(&c, "blur");
+        assert_eq!(blur.verdict, Verdict::Regressed, "{}", table(&c));
+        // The samples' own change is 20 % ± their 1 % noise; the interval is that narrow.
+        let (lo, hi) = (blur.ci_low.unwrap(), blur.ci_high.unwrap());
+        assert!((blur.change.unwrap() - 0.2).abs() < 0.01, "{blur:?}");
+        assert!(lo > 0.18 && hi < 0.22 && hi - lo < 0.02, "{lo} {hi}");
+        assert_eq!(row(&c, "skin").verdict, Verdict::Unchanged);
+        assert!(c.regressed());
+        // The other way round it is an improvement.
+        let back = compare(&b, &a, &CompareOptions::default()).unwrap();
+        assert_eq!(row(&back, "blur").verdict, Verdict::Improved);
+    }
+
+    #[test]
+    fn a_busier_machine_cancels_in_ruler_units() {
+        // Runs ±20 % apart from machine load, the new side 30 % busier still:
+        // the ruler steadies it, so it is chosen, and nothing changed.
+        let load = |side: f64| move |r: usize, _| side * (1.0 + 0.2 * noise(r + 77));
+        let a = measurement(
+            10,
+            4,
+            |r, f| 3000.0 * (1.0 + 0.005 * noise(r * 5 + f)),
+            load(1.0),
+        );
+        let b = measurement(
+            10,
+            4,
+            |r, f| 3000.0 * (1.0 + 0.005 * noise(r * 5 + f + 9)),
+            load(1.3),
+        );
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        assert_eq!(row(&c, "blur").unit, "ruler");
+        assert_eq!(row(&c, "blur").verdict, Verdict::Unchanged, "{}", table(&c));
+        assert!(row(&c, "blur").change_ms.unwrap() > 0.2);
+        assert!(!c.regressed(), "a ruler is shown, not judged");
+        // In ms the same data is a regression (or at least no "unchanged").
+        let ms = CompareOptions {
+            unit: Unit::Ms,
+            ..Default::default()
+        };
+        let c = compare(&a, &b, &ms).unwrap();
+        assert_ne!(row(&c, "blur").verdict, Verdict::Unchanged, "{}", table(&c));
+    }
+
+    #[test]
+    fn a_ruler_noisier_than_the_passes_is_not_used() {
+        // A steady machine, a ruler that jitters ±50 % (a tiny pass on a host
+        // clock): auto compares in ms.
+        let mut a = measurement(
+            10,
+            3,
+            |r, f| 3000.0 * (1.0 + 0.01 * noise(r * 3 + f)),
+            |_, _| 1.0,
+        );
+        for (i, f) in a.frames.iter_mut().enumerate() {
+            f.passes
+                .insert(RULER_COPY.into(), 1000.0 * (1.0 + 0.5 * noise(i + 300)));
+        }
+        let c = compare(&a, &a, &CompareOptions::default()).unwrap();
+        assert_eq!(row(&c, "blur").unit, "ms");
+        assert!(
+            c.warnings.iter().any(|w| w.contains("does not steady")),
+            "{:?}",
+            c.warnings
+        );
+        assert_eq!(row(&c, "blur").verdict, Verdict::Unchanged);
+    }
+
+    #[test]
+    fn heavy_overlap_is_inconclusive_and_says_how_much_more() {
+        // ±20 % noise, 3 runs a side, a 4 % shift: nothing can be decided.
+        let a = measurement(
+            3,
+            3,
+            |r, f| 3000.0 * (1.0 + 0.2 * noise(r * 3 + f)),
+            |_, _| 1.0,
+        );
+        let b = measurement(
+            3,
+            3,
+            |r, f| 3120.0 * (1.0 + 0.2 * noise(r * 3 + f + 40)),
+            |_, _| 1.0,
+        );
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        let blur = row(&c, "blur");
+        assert_eq!(blur.verdict, Verdict::Inconclusive, "{}", table(&c));
+        assert!(blur.more_samples.is_some_and(|k| k >= 1), "{blur:?}");
+        assert!(table(&c).contains("more runs per side"), "{}", table(&c));
+    }
+
+    #[test]
+    fn one_run_a_side_compares_frames_and_warns() {
+        let a = measurement(1, 20, |_, f| 3000.0 * (1.0 + 0.01 * noise(f)), |_, _| 1.0);
+        let b = measurement(
+            1,
+            20,
+            |_, f| 3900.0 * (1.0 + 0.01 * noise(f + 3)),
+            |_, _| 1.0,
+        );
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        assert_eq!(row(&c, "blur").sample, "frame");
+        assert_eq!(row(&c, "blur").verdict, Verdict::Regressed);
+        assert!(
+            c.warnings.iter().any(|w| w.contains("one run")),
+            "{:?}",
+            c.warnings
+        );
+    }
+
+    #[test]
+    fn setups_and_clocks_are_checked_first() {
+        let mut a = measurement(2, 2, |_, _| 1.0, |_, _| 1.0);
+        let mut b = a.clone();
+        a.setup
+            .insert("irradiance_resolution".into(), "1024".into());
+        b.setup
+            .insert("irradiance_resolution".into(), "2048".into());
+        let e = compare(&a, &b, &CompareOptions::default()).unwrap_err();
+        assert!(
+            e.to_string().contains("irradiance_resolution: 1024 → 2048"),
+            "{e}"
+        );
+        let allowed = CompareOptions {
+            allow_setup_change: true,
+            ..Default::default()
+        };
+        assert!(compare(&a, &b, &allowed).is_ok());
+        // A kernel change is the change under test: listed, not refused.
+        b.setup
+            .insert("irradiance_resolution".into(), "1024".into());
+        a.setup.insert("kernel".into(), "deon7".into());
+        b.setup.insert("kernel".into(), "accurate".into());
+        b.fingerprint.cpu_cores = 16;
+        let c = compare(&a, &b, &CompareOptions::default()).unwrap();
+        assert_eq!(c.setup_changes, ["kernel: deon7 → accurate"]);
+        assert!(c.warnings.iter().any(|w| w.contains("cpu_cores: 0 → 16")));
+        b.fingerprint.clock = "host-fence".into();
+        a.fingerprint.clock = "gpu-timestamp".into();
+        assert!(compare(&a, &b, &CompareOptions::default()).is_err());
+    }
+
+    #[test]
+    fn pooling_joins_runs_of_one_setup_only() {
+        let a = measurement(1, 3, |_, _| 1.0, |_, _| 1.0);
+        let mut b = measurement(1, 3, |_, _| 1.0, |_, _| 1.0);
+        for f in &mut b.frames {
+            f.run = "other".into();
+        }
+        let (all, warnings) = Measurement::pool(vec![a.clone(), b.clone()]).unwrap();
+        assert_eq!((all.frames.len(), all.runs()), (6, 2));
+        assert!(warnings.is_empty());
+        b.setup.insert("view".into(), "irradiance".into());
+        assert!(Measurement::pool(vec![a, b]).is_err());
+    }
+}
