@@ -118,52 +118,12 @@ enum Command {
     /// Time against quality: render every irradiance resolution × blur kernel ×
     /// diffusion chain with the rulers and compare each final image and diffuse
     /// term with a reference over the face (RMSE and max relative to the mean,
-    /// 99th percentile, PSNR). Writes sweep.csv, sweep.json, time_vs_error.{svg,png}
-    /// and passes.{svg,png} into --out-dir (docs/performance.md).
-    #[command(after_help = AFTER_HELP)]
-    Sweep {
-        /// Scene file, or `builtin`; default: assets/default.toml. Its skybox is
-        /// turned off: the face mask is the image's alpha.
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        /// Irradiance resolutions (powers of two, 256..8192), comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
-        resolutions: Vec<u32>,
-        /// Blur kernels, comma-separated.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "deon7,accurate"
-        )]
-        kernels: Vec<Kernel>,
-        /// Diffusion chains, comma-separated.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "full,adaptive"
-        )]
-        chains: Vec<Chain>,
-        /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
-        #[arg(long, default_value_t = 4)]
-        frames: u32,
-        /// Irradiance resolution of the reference (accurate kernel, full chain).
-        #[arg(long, default_value_t = 4096)]
-        reference_resolution: u32,
-        /// Output width in pixels, replacing the scene's.
-        #[arg(long)]
-        width: Option<u32>,
-        /// Output height in pixels, replacing the scene's.
-        #[arg(long)]
-        height: Option<u32>,
-        /// Directory for the CSV, JSON and plots (created).
-        #[arg(long, default_value = "sweep")]
-        out_dir: PathBuf,
-        /// Render nothing: redraw the plots and CSV of --out-dir from its sweep.json.
-        #[arg(long)]
-        replot: bool,
-    },
+    /// 99th percentile, PSNR). Writes points.jsonl, sweep.csv, sweep.json,
+    /// time_vs_error.{svg,png} and passes.{svg,png} into --out-dir; with --shard,
+    /// only this shard's points-shard-I-of-N.jsonl, for `dermis sweep merge`
+    /// (docs/performance.md, docs/recipes/).
+    #[command(after_help = AFTER_HELP, args_conflicts_with_subcommands = true)]
+    Sweep(SweepArgs),
     /// Lighting against the truth: for each environment, the direct term
     /// (`--view direct`, grey albedo) with the paper's SH9 alone and with the
     /// bright sources extracted as shadowed lights, each against the CPU
@@ -352,6 +312,93 @@ enum Command {
     },
 }
 
+#[derive(clap::Args)]
+struct SweepArgs {
+    #[command(subcommand)]
+    command: Option<SweepCommand>,
+    /// Scene file, or `builtin`; default: assets/default.toml. Its skybox is
+    /// turned off: the face mask is the image's alpha.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Irradiance resolutions (powers of two, 256..8192), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
+    resolutions: Vec<u32>,
+    /// Blur kernels, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "deon7,accurate"
+    )]
+    kernels: Vec<Kernel>,
+    /// Diffusion chains, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "full,adaptive"
+    )]
+    chains: Vec<Chain>,
+    /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
+    #[arg(long, default_value_t = 4)]
+    frames: u32,
+    /// Irradiance resolution of the reference (accurate kernel, full chain).
+    #[arg(long, default_value_t = 4096)]
+    reference_resolution: u32,
+    /// Output width in pixels, replacing the scene's.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Output height in pixels, replacing the scene's.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Directory for the CSV, JSON and plots (created).
+    #[arg(long, default_value = "sweep")]
+    out_dir: PathBuf,
+    /// Render nothing: redraw the plots and CSV of --out-dir from its sweep.json.
+    #[arg(long)]
+    replot: bool,
+    /// Render only this shard of the points: I/N (1-based; same as hash:I/N, by a
+    /// hash of each point's id, stable as points are added), count:I/N (every
+    /// N-th point from the I-th: balanced), or auto (from Slurm, Kubernetes,
+    /// GitLab, Bazel or DERMIS_SHARD; see docs/performance.md). Without it,
+    /// DERMIS_SHARD (same syntax) is read. Writes points-shard-I-of-N.jsonl
+    /// into --out-dir; merge with `dermis sweep merge`.
+    #[arg(long, value_name = "I/N|hash:I/N|count:I/N|auto")]
+    shard: Option<String>,
+    /// Render nothing: print the points (id, resolution, kernel, chain) in
+    /// canonical order and the sweep hash.
+    #[arg(long)]
+    list_points: bool,
+    /// With --list-points: print JSON.
+    #[arg(long, requires = "list_points")]
+    json: bool,
+    /// Skip the points already in --out-dir's log for this sweep (same sweep
+    /// hash), appending the rest to it.
+    #[arg(long)]
+    resume: bool,
+}
+
+#[derive(Subcommand)]
+enum SweepCommand {
+    /// Merge the points logs (*.jsonl) of a sharded sweep into sweep.json,
+    /// sweep.csv and the plots, as an unsharded sweep writes them. Every point
+    /// must appear; of duplicates the later run's is kept (header timestamp,
+    /// then argument and file-name order, then line order).
+    #[command(after_help = AFTER_HELP)]
+    Merge {
+        /// Folders (their *.jsonl) or files.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Where to write; default: the first input folder.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// Merge even when the shards' reference images differ (their errors
+        /// are then against different images).
+        #[arg(long)]
+        allow_reference_mismatch: bool,
+    },
+}
+
 /// `--background R,G,B`.
 fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
     let v: Vec<f32> = s
@@ -373,6 +420,123 @@ fn write_file(path: &Path, text: &str) -> dermis::Result<()> {
         path: path.display().to_string(),
         source,
     })
+}
+
+/// `dermis sweep` and `dermis sweep merge`.
+fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
+    use dermis::sweep::{self as sw, output};
+    if let Some(SweepCommand::Merge {
+        inputs,
+        out_dir,
+        allow_reference_mismatch,
+    }) = args.command
+    {
+        let merged = sw::merge::merge(
+            &inputs,
+            sw::merge::MergeOptions {
+                allow_reference_mismatch,
+            },
+        )?;
+        for w in &merged.warnings {
+            eprintln!("warning: {w}");
+        }
+        let out_dir = out_dir.unwrap_or_else(|| sw::merge::default_out_dir(&inputs));
+        output::write_all(&merged.sweep, &out_dir)?;
+        println!(
+            "merged {} points from {} run(s) into {}",
+            merged.sweep.points.len(),
+            merged.sweep.shards.len(),
+            out_dir.display()
+        );
+        return Ok(());
+    }
+    let out_dir = args.out_dir;
+    if args.replot {
+        let sweep = sw::load(&out_dir.join("sweep.json"))?;
+        output::write_csv_and_plots(&sweep, &out_dir)?;
+        println!("redrew {}", out_dir.display());
+        return Ok(());
+    }
+    let file = Overrides {
+        width: args.width,
+        height: args.height,
+        ..Overrides::default()
+    }
+    .apply(scene_by_name(args.scene.as_deref())?)?;
+    let opts = sw::SweepOptions {
+        scene: file,
+        scene_label: args
+            .scene
+            .unwrap_or_else(default_scene_path)
+            .display()
+            .to_string(),
+        resolutions: args.resolutions,
+        kernels: args.kernels,
+        chains: args.chains,
+        frames: args.frames,
+        reference_resolution: args.reference_resolution,
+    };
+    sw::validate(&opts)?;
+    if args.list_points {
+        let list = sw::points::list(&opts);
+        if args.json {
+            println!("{}", to_json(Path::new("stdout"), &list)?);
+        } else {
+            for p in &list.points {
+                println!("{}", p.id);
+            }
+            println!("sweep hash {} ({} points)", list.sweep_hash, list.points.len());
+        }
+        return Ok(());
+    }
+    let env = |k: &str| std::env::var(k).ok();
+    let resolved = sw::shard::resolve(args.shard.as_deref(), &env)?;
+    if let Some(r) = &resolved {
+        sw::shard::acknowledge(r)?;
+        eprintln!("{r}");
+    }
+    std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
+        path: out_dir.display().to_string(),
+        source,
+    })?;
+    let shard = resolved.map(|r| r.shard);
+    let log = out_dir.join(shard.map_or_else(|| "points.jsonl".into(), |s| s.file_name()));
+    let ctx = Context::new(context)?;
+    println!(
+        "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
+        "res", "kernel", "chain", "frame ms", "chain ms", "ruler ns", "final %", "diffuse %", "pool MiB"
+    );
+    let how = sw::RunOptions {
+        shard,
+        log: Some(log.clone()),
+        resume: args.resume,
+    };
+    let sweep = sw::run(&ctx, &opts, &how, |p| {
+        let v = p.variant;
+        println!(
+            "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
+            v.resolution,
+            format!("{:?}", v.kernel).to_lowercase(),
+            format!("{:?}", v.chain).to_lowercase(),
+            p.total_ms,
+            p.chain_ms,
+            sw::ruler_ns_per_texel(p).unwrap_or(f64::NAN),
+            100.0 * p.final_error.rmse_rel,
+            100.0 * p.diffuse_error.rmse_rel,
+            p.transient_bytes as f64 / (1u64 << 20) as f64
+        );
+    })?;
+    if shard.is_some() {
+        println!(
+            "wrote {} ({} points); merge the shards with `dermis sweep merge`",
+            log.display(),
+            sweep.points.len()
+        );
+    } else {
+        output::write_all(&sweep, &out_dir)?;
+        println!("wrote {}", out_dir.display());
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -574,83 +738,7 @@ fn run(cli: Cli) -> dermis::Result<()> {
             }
             Ok(())
         }
-        Command::Sweep {
-            scene,
-            resolutions,
-            kernels,
-            chains,
-            frames,
-            reference_resolution,
-            width,
-            height,
-            out_dir,
-            replot,
-        } => {
-            if replot {
-                let sweep = dermis::sweep::load(&out_dir.join("sweep.json"))?;
-                write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
-                dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
-                println!("redrew {}", out_dir.display());
-                return Ok(());
-            }
-            let file = Overrides {
-                width,
-                height,
-                ..Overrides::default()
-            }
-            .apply(scene_by_name(scene.as_deref())?)?;
-            let opts = dermis::sweep::SweepOptions {
-                scene: file,
-                scene_label: scene
-                    .unwrap_or_else(default_scene_path)
-                    .display()
-                    .to_string(),
-                resolutions,
-                kernels,
-                chains,
-                frames,
-                reference_resolution,
-            };
-            dermis::sweep::validate(&opts)?;
-            std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
-                path: out_dir.display().to_string(),
-                source,
-            })?;
-            let ctx = Context::new(&context)?;
-            println!(
-                "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
-                "res",
-                "kernel",
-                "chain",
-                "frame ms",
-                "chain ms",
-                "ruler ns",
-                "final %",
-                "diffuse %",
-                "pool MiB"
-            );
-            let sweep = dermis::sweep::run(&ctx, &opts, |p| {
-                let v = p.variant;
-                println!(
-                    "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
-                    v.resolution,
-                    format!("{:?}", v.kernel).to_lowercase(),
-                    format!("{:?}", v.chain).to_lowercase(),
-                    p.total_ms,
-                    p.chain_ms,
-                    dermis::sweep::ruler_ns_per_texel(p).unwrap_or(f64::NAN),
-                    100.0 * p.final_error.rmse_rel,
-                    100.0 * p.diffuse_error.rmse_rel,
-                    p.transient_bytes as f64 / (1u64 << 20) as f64
-                );
-            })?;
-            let json = out_dir.join("sweep.json");
-            write_file(&json, &to_json(&json, &sweep)?)?;
-            write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
-            dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
-            println!("wrote {}", out_dir.display());
-            Ok(())
-        }
+        Command::Sweep(args) => sweep(args, &context),
         Command::Reference {
             scene,
             envs,

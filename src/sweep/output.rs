@@ -1,0 +1,57 @@
+//! Writing a sweep's files: each to a temporary name in its folder, then renamed
+//! into place, so a reader (or a killed sweep) never sees half a file.
+
+use super::{csv, plot, Sweep};
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// `dir/.name.tmp-PID` → `dir/name`, keeping the extension last (the plot
+/// backends choose the format by it).
+pub fn temporary(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let tmp = match name.rsplit_once('.') {
+        Some((stem, ext)) => format!(".{stem}.tmp-{}.{ext}", std::process::id()),
+        None => format!(".{name}.tmp-{}", std::process::id()),
+    };
+    path.with_file_name(tmp)
+}
+
+/// Renames `tmp` over `path`.
+pub fn commit(tmp: &Path, path: &Path) -> Result<()> {
+    std::fs::rename(tmp, path).map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `text` to `path` through a temporary file.
+pub fn write_atomic(path: &Path, text: &str) -> Result<()> {
+    let tmp = temporary(path);
+    std::fs::write(&tmp, text).map_err(|source| Error::Io {
+        path: tmp.display().to_string(),
+        source,
+    })?;
+    commit(&tmp, path)
+}
+
+pub fn json(sweep: &Sweep) -> Result<String> {
+    serde_json::to_string_pretty(sweep).map_err(|e| Error::Input(format!("sweep.json: {e}")))
+}
+
+/// `sweep.csv` and the plots (what `--replot` redraws).
+pub fn write_csv_and_plots(sweep: &Sweep, dir: &Path) -> Result<()> {
+    write_atomic(&dir.join("sweep.csv"), &csv(sweep))?;
+    plot::write_plots(sweep, dir)
+}
+
+/// `sweep.json`, `sweep.csv` and the plots into `dir` (created).
+pub fn write_all(sweep: &Sweep, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    write_atomic(&dir.join("sweep.json"), &json(sweep)?)?;
+    write_csv_and_plots(sweep, dir)
+}
