@@ -477,8 +477,14 @@ fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
         reference_resolution: args.reference_resolution,
     };
     sw::validate(&opts)?;
+    let env = |k: &str| std::env::var(k).ok();
+    let resolved = sw::shard::resolve(args.shard.as_deref(), &env)?;
+    if let Some(r) = &resolved {
+        eprintln!("{r}");
+    }
+    let shard = resolved.as_ref().map(|r| r.shard);
     if args.list_points {
-        let list = sw::points::list(&opts);
+        let list = sw::points::list(&opts, shard);
         if args.json {
             println!("{}", to_json(Path::new("stdout"), &list)?);
         } else {
@@ -489,17 +495,13 @@ fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
         }
         return Ok(());
     }
-    let env = |k: &str| std::env::var(k).ok();
-    let resolved = sw::shard::resolve(args.shard.as_deref(), &env)?;
     if let Some(r) = &resolved {
         sw::shard::acknowledge(r)?;
-        eprintln!("{r}");
     }
     std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
         path: out_dir.display().to_string(),
         source,
     })?;
-    let shard = resolved.map(|r| r.shard);
     let log = out_dir.join(shard.map_or_else(|| "points.jsonl".into(), |s| s.file_name()));
     let ctx = Context::new(context)?;
     println!(

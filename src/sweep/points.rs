@@ -2,6 +2,7 @@
 //! sweep hash: one number over everything that makes two runs' points
 //! comparable (and two shards' points parts of one sweep).
 
+use super::shard::Shard;
 use super::{name, SweepOptions, Variant};
 use crate::scene::file::{Chain, Kernel};
 use serde::Serialize;
@@ -120,6 +121,10 @@ pub struct PointList {
     pub schema_version: u32,
     pub sweep_hash: String,
     pub reference: String,
+    /// `hash:2/3` when the list is one shard's; absent for the whole sweep.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
+    /// The shard's points (all without one), canonical order.
     pub points: Vec<ListedPoint>,
 }
 
@@ -130,14 +135,18 @@ pub struct ListedPoint {
     pub variant: Variant,
 }
 
-pub fn list(opts: &SweepOptions) -> PointList {
+/// The sweep's points, or `shard`'s.
+pub fn list(opts: &SweepOptions, shard: Option<Shard>) -> PointList {
     PointList {
         schema_version: SWEEP_SCHEMA_VERSION,
         sweep_hash: sweep_hash(opts),
         reference: reference(opts).id(),
+        shard: shard.map(|s| s.to_string()),
         points: variants(opts)
             .into_iter()
-            .map(|variant| ListedPoint {
+            .enumerate()
+            .filter(|(i, v)| shard.is_none_or(|s| s.takes(*i, &v.id())))
+            .map(|(_, variant)| ListedPoint {
                 id: variant.id(),
                 variant,
             })
