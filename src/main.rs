@@ -491,7 +491,11 @@ fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
             for p in &list.points {
                 println!("{}", p.id);
             }
-            println!("sweep hash {} ({} points)", list.sweep_hash, list.points.len());
+            println!(
+                "sweep hash {} ({} points)",
+                list.sweep_hash,
+                list.points.len()
+            );
         }
         return Ok(());
     }
@@ -506,7 +510,15 @@ fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
     let ctx = Context::new(context)?;
     println!(
         "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
-        "res", "kernel", "chain", "frame ms", "chain ms", "ruler ns", "final %", "diffuse %", "pool MiB"
+        "res",
+        "kernel",
+        "chain",
+        "frame ms",
+        "chain ms",
+        "ruler ns",
+        "final %",
+        "diffuse %",
+        "pool MiB"
     );
     let how = sw::RunOptions {
         shard,

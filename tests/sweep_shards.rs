@@ -65,8 +65,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn json(path: &Path) -> Value {
-    let text = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -125,7 +124,12 @@ fn three_shards_merge_into_the_unsharded_sweep() {
         let shard = format!("{i}/3");
         children.push((
             format!("shard {shard}"),
-            spawn(&with(&["--shard", &shard, "--out-dir", shards.to_str().unwrap()])),
+            spawn(&with(&[
+                "--shard",
+                &shard,
+                "--out-dir",
+                shards.to_str().unwrap(),
+            ])),
         ));
     }
     for (what, child) in children {
@@ -176,7 +180,9 @@ fn three_shards_merge_into_the_unsharded_sweep() {
         checksums.push(header["reference_checksum"].clone());
     }
     assert_eq!(total, 2);
-    assert!(checksums.iter().all(|c| *c == unsharded["reference_checksum"]));
+    assert!(checksums
+        .iter()
+        .all(|c| *c == unsharded["reference_checksum"]));
 
     // --list-points --json: the same ids and hash, nothing rendered.
     let out = dermis(&with(&["--list-points", "--json"]), &[]);
@@ -200,7 +206,14 @@ fn three_shards_merge_into_the_unsharded_sweep() {
     assert!(!stderr.contains("warning"), "{stderr}");
     let m = json(&merged.join("sweep.json"));
     assert_eq!(ids(&m), ids(&unsharded));
-    for key in ["sweep_hash", "reference_checksum", "reference", "scene", "width", "frames"] {
+    for key in [
+        "sweep_hash",
+        "reference_checksum",
+        "reference",
+        "scene",
+        "width",
+        "frames",
+    ] {
         assert_eq!(m[key], unsharded[key], "{key}");
     }
     for (a, b) in m["points"]
@@ -209,17 +222,33 @@ fn three_shards_merge_into_the_unsharded_sweep() {
         .iter()
         .zip(unsharded["points"].as_array().unwrap())
     {
-        for key in ["final_error", "diffuse_error", "resolution", "kernel", "chain"] {
+        for key in [
+            "final_error",
+            "diffuse_error",
+            "resolution",
+            "kernel",
+            "chain",
+        ] {
             assert_eq!(a[key], b[key], "{}: {key}", a["id"]);
         }
         let names = |p: &Value| -> Vec<Value> {
-            p["passes"].as_array().unwrap().iter().map(|s| s["name"].clone()).collect()
+            p["passes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|s| s["name"].clone())
+                .collect()
         };
         assert_eq!(names(a), names(b));
         assert!(a["total_ms"].as_f64().unwrap() > 0.0);
     }
     assert_eq!(m["shards"].as_array().unwrap().len(), 3);
-    for f in ["sweep.csv", "time_vs_error.svg", "time_vs_error.png", "passes.png"] {
+    for f in [
+        "sweep.csv",
+        "time_vs_error.svg",
+        "time_vs_error.png",
+        "passes.png",
+    ] {
         assert!(merged.join(f).is_file(), "merge wrote no {f}");
     }
     let csv = std::fs::read_to_string(merged.join("sweep.csv")).unwrap();
@@ -236,7 +265,10 @@ fn three_shards_merge_into_the_unsharded_sweep() {
     let out = dermis(&["sweep", "merge", shards.to_str().unwrap()], &[]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("missing") && stderr.contains("r256-"), "{stderr}");
+    assert!(
+        stderr.contains("missing") && stderr.contains("r256-"),
+        "{stderr}"
+    );
 
     // A killed sweep resumed: the log cut inside its last point; --resume
     // renders only that point and gives the same sweep.
@@ -244,11 +276,17 @@ fn three_shards_merge_into_the_unsharded_sweep() {
     let cut = log.trim_end().rfind('\n').unwrap() + 40;
     std::fs::write(whole.join("points.jsonl"), &log[..cut]).unwrap();
     std::fs::remove_file(whole.join("sweep.json")).unwrap();
-    let out = dermis(&with(&["--resume", "--out-dir", whole.to_str().unwrap()]), &[]);
+    let out = dermis(
+        &with(&["--resume", "--out-dir", whole.to_str().unwrap()]),
+        &[],
+    );
     check("--resume", &out);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(
-        stdout.lines().filter(|l| l.trim_start().starts_with("256 ")).count(),
+        stdout
+            .lines()
+            .filter(|l| l.trim_start().starts_with("256 "))
+            .count(),
         1,
         "--resume rendered more than the lost point:\n{stdout}"
     );
@@ -275,7 +313,10 @@ fn shard_auto_reads_the_scheduler_and_bad_shards_exit_2() {
         ("SLURM_ARRAY_TASK_STEP", "1"),
         ("SLURM_ARRAY_TASK_COUNT", "3"),
     ];
-    let out = dermis(&with(&["--shard", "count:auto", "--list-points", "--json"]), &slurm);
+    let out = dermis(
+        &with(&["--shard", "count:auto", "--list-points", "--json"]),
+        &slurm,
+    );
     let stderr = check("--shard auto", &out);
     assert!(
         stderr.contains("shard 3/3 by position (from SLURM_ARRAY_TASK_ID=3)"),
@@ -283,9 +324,16 @@ fn shard_auto_reads_the_scheduler_and_bad_shards_exit_2() {
     );
     let list: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(list["shard"], "count:3/3");
-    assert_eq!(ids(&list), Vec::<String>::new(), "two points, the third shard by position is empty");
+    assert_eq!(
+        ids(&list),
+        Vec::<String>::new(),
+        "two points, the third shard by position is empty"
+    );
     // DERMIS_SHARD without --shard; an explicit --shard wins over it.
-    let out = dermis(&with(&["--list-points", "--json"]), &[("DERMIS_SHARD", "count:2/2")]);
+    let out = dermis(
+        &with(&["--list-points", "--json"]),
+        &[("DERMIS_SHARD", "count:2/2")],
+    );
     check("DERMIS_SHARD", &out);
     let list: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(ids(&list), ["r256-accurate-full"]);

@@ -59,7 +59,9 @@ pub fn inputs(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         }
     }
     if out.is_empty() {
-        return Err(Error::Input("sweep merge: give at least one folder or file".into()));
+        return Err(Error::Input(
+            "sweep merge: give at least one folder or file".into(),
+        ));
     }
     Ok(out)
 }
@@ -77,7 +79,7 @@ pub fn merge(paths: &[PathBuf], opts: MergeOptions) -> Result<Merged> {
     Ok(merged)
 }
 
-fn files_by<'a>(segments: &'a [Segment], key: impl Fn(&Segment) -> String) -> String {
+fn files_by(segments: &[Segment], key: impl Fn(&Segment) -> String) -> String {
     let mut by: BTreeMap<String, Vec<String>> = BTreeMap::new();
     for s in segments {
         let f = s.file.display().to_string();
@@ -123,7 +125,10 @@ pub fn merge_segments(mut segments: Vec<Segment>, opts: MergeOptions) -> Result<
         let what = format!(
             "the shards' reference images differ, so their errors are not measured against \
              the same image: {}",
-            files_by(&segments, |s| format!("reference {}", s.header.reference_checksum))
+            files_by(&segments, |s| format!(
+                "reference {}",
+                s.header.reference_checksum
+            ))
         );
         if !opts.allow_reference_mismatch {
             return Err(Error::Input(format!(
@@ -231,7 +236,9 @@ pub fn default_out_dir(paths: &[PathBuf]) -> PathBuf {
         || PathBuf::from("."),
         |p| match p.is_dir() {
             true => p.clone(),
-            false => p.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+            false => p
+                .parent()
+                .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
         },
     )
 }
@@ -328,7 +335,10 @@ mod tests {
             segment("c.jsonl", T0, vec![point(512, 0.2)]),
         ]);
         let ids: Vec<&str> = m.sweep.points.iter().map(|p| p.id.as_str()).collect();
-        assert_eq!(ids, ["r256-deon7-full", "r512-deon7-full", "r1024-deon7-full"]);
+        assert_eq!(
+            ids,
+            ["r256-deon7-full", "r512-deon7-full", "r1024-deon7-full"]
+        );
         assert!(m.warnings.is_empty(), "{:?}", m.warnings);
         assert_eq!(m.sweep.shards.len(), 3);
         assert_eq!(m.sweep.shards[1].points, Vec::<String>::new());
@@ -337,7 +347,11 @@ mod tests {
 
     #[test]
     fn rejects_a_missing_point_naming_it() {
-        let e = err(vec![segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)])]);
+        let e = err(vec![segment(
+            "a.jsonl",
+            T0,
+            vec![point(256, 0.3), point(1024, 0.1)],
+        )]);
         assert!(e.contains("r512-deon7-full") && e.contains("1 of 3"), "{e}");
     }
 
@@ -345,15 +359,24 @@ mod tests {
     fn rejects_mismatched_sweep_hashes_naming_the_files() {
         let mut b = segment("b.jsonl", T0, vec![point(512, 0.2)]);
         b.header.sweep_hash = "00000000000000bb".into();
-        let e = err(vec![segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)]), b]);
-        assert!(e.contains("a.jsonl") && e.contains("b.jsonl") && e.contains("00000000000000bb"), "{e}");
+        let e = err(vec![
+            segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)]),
+            b,
+        ]);
+        assert!(
+            e.contains("a.jsonl") && e.contains("b.jsonl") && e.contains("00000000000000bb"),
+            "{e}"
+        );
     }
 
     #[test]
     fn rejects_another_schema_version() {
         let mut b = segment("b.jsonl", T0, vec![point(512, 0.2)]);
         b.header.schema_version = SWEEP_SCHEMA_VERSION + 1;
-        let e = err(vec![segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)]), b]);
+        let e = err(vec![
+            segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)]),
+            b,
+        ]);
         assert!(e.contains("schema") && e.contains("b.jsonl"), "{e}");
     }
 
@@ -383,7 +406,10 @@ mod tests {
         b.header.fingerprint.cpu_cores = 16;
         let a = segment("a.jsonl", T0, vec![point(256, 0.3), point(1024, 0.1)]);
         let e = err(vec![a.clone(), b.clone()]);
-        assert!(e.contains("reference") && e.contains("--allow-reference-mismatch"), "{e}");
+        assert!(
+            e.contains("reference") && e.contains("--allow-reference-mismatch"),
+            "{e}"
+        );
         let m = merge_segments(
             vec![a, b],
             MergeOptions {

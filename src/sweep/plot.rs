@@ -105,7 +105,11 @@ where
         sweep.scene, sweep.width, sweep.height
     );
     if shown.is_empty() {
-        return nothing(&area, &title, "no point with a positive, finite error to plot");
+        return nothing(
+            &area,
+            &title,
+            "no point with a positive, finite error to plot",
+        );
     }
     area.fill(&WHITE).map_err(e)?;
     let pts: Vec<(f64, f64)> = shown
@@ -355,11 +359,19 @@ mod tests {
             ("zero times", vec![(0.0, 0.1), (0.0, 0.2)]),
             ("constant", vec![(5.0, 0.1), (5.0, 0.1), (5.0, 0.1)]),
             ("one point", vec![(5.0, 0.1)]),
-            ("not finite", vec![(f64::NAN, f64::INFINITY), (f64::INFINITY, 0.1)]),
+            (
+                "not finite",
+                vec![(f64::NAN, f64::INFINITY), (f64::INFINITY, 0.1)],
+            ),
         ];
         for (what, points) in cases {
             write_plots(&sweep(points), &dir).unwrap_or_else(|e| panic!("{what}: {e}"));
-            for f in ["time_vs_error.svg", "time_vs_error.png", "passes.svg", "passes.png"] {
+            for f in [
+                "time_vs_error.svg",
+                "time_vs_error.png",
+                "passes.svg",
+                "passes.png",
+            ] {
                 assert!(dir.join(f).is_file(), "{what}: {f}");
             }
         }
@@ -376,7 +388,10 @@ mod tests {
     fn log_ranges_are_never_empty() {
         for v in [vec![], vec![0.0], vec![3.0], vec![3.0, 3.0], vec![f64::NAN]] {
             let r = log_range(&v);
-            assert!(r.start > 0.0 && r.end > r.start && r.end.is_finite(), "{v:?}: {r:?}");
+            assert!(
+                r.start > 0.0 && r.end > r.start && r.end.is_finite(),
+                "{v:?}: {r:?}"
+            );
         }
     }
 }

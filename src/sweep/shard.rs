@@ -84,9 +84,7 @@ pub fn parse(value: &str) -> Result<Spec> {
     if rest == "auto" {
         return Ok(Spec::Auto(mode));
     }
-    let (i, n) = rest
-        .split_once('/')
-        .ok_or_else(|| bad(value, "no '/'"))?;
+    let (i, n) = rest.split_once('/').ok_or_else(|| bad(value, "no '/'"))?;
     let number = |s: &str, what: &str| {
         s.trim()
             .parse::<u32>()
@@ -102,7 +100,9 @@ fn check(index: u32, total: u32) -> std::result::Result<(), String> {
         return Err("the total is 0".into());
     }
     if index == 0 || index > total {
-        return Err(format!("shard {index} is not in 1..={total} (shards count from 1)"));
+        return Err(format!(
+            "shard {index} is not in 1..={total} (shards count from 1)"
+        ));
     }
     Ok(())
 }
@@ -144,7 +144,10 @@ impl fmt::Display for Resolved {
 /// environment); GitLab `parallel:` (`CI_NODE_INDEX`, 1-based, `CI_NODE_TOTAL`);
 /// Bazel test sharding (`TEST_SHARD_INDEX`, 0-based, `TEST_TOTAL_SHARDS`).
 /// GitHub Actions sets nothing: pass `--shard` or `DERMIS_SHARD` explicitly.
-pub fn resolve(flag: Option<&str>, env: &dyn Fn(&str) -> Option<String>) -> Result<Option<Resolved>> {
+pub fn resolve(
+    flag: Option<&str>,
+    env: &dyn Fn(&str) -> Option<String>,
+) -> Result<Option<Resolved>> {
     let (spec, source) = match flag {
         Some(f) => (parse(f)?, "--shard"),
         None => match env("DERMIS_SHARD").filter(|v| !v.trim().is_empty()) {
@@ -170,9 +173,9 @@ fn from_env(mode: Mode, env: &dyn Fn(&str) -> Option<String>) -> Result<Resolved
     let num = |k: &str| -> Result<Option<u32>> {
         get(k)
             .map(|v| {
-                v.trim().parse::<u32>().map_err(|_| {
-                    Error::Input(format!("--shard auto: {k}={v:?} is not a number"))
-                })
+                v.trim()
+                    .parse::<u32>()
+                    .map_err(|_| Error::Input(format!("--shard auto: {k}={v:?} is not a number")))
             })
             .transpose()
     };
@@ -235,7 +238,12 @@ fn from_env(mode: Mode, env: &dyn Fn(&str) -> Option<String>) -> Result<Resolved
             "DERMIS_SHARD_TOTAL",
             "JOB_COMPLETION_INDEX is set (a Kubernetes Indexed Job; set DERMIS_SHARD_TOTAL to the Job's completions)",
         )?;
-        return done(index0, total, format!("JOB_COMPLETION_INDEX={index0}"), None);
+        return done(
+            index0,
+            total,
+            format!("JOB_COMPLETION_INDEX={index0}"),
+            None,
+        );
     }
     if let Some(index1) = num("CI_NODE_INDEX")? {
         let total = need("CI_NODE_TOTAL", "CI_NODE_INDEX is set (GitLab parallel:)")?;
@@ -247,7 +255,10 @@ fn from_env(mode: Mode, env: &dyn Fn(&str) -> Option<String>) -> Result<Resolved
         return done(index1 - 1, total, format!("CI_NODE_INDEX={index1}"), None);
     }
     if let Some(index0) = num("TEST_SHARD_INDEX")? {
-        let total = need("TEST_TOTAL_SHARDS", "TEST_SHARD_INDEX is set (Bazel test sharding)")?;
+        let total = need(
+            "TEST_TOTAL_SHARDS",
+            "TEST_SHARD_INDEX is set (Bazel test sharding)",
+        )?;
         return done(
             index0,
             total,
@@ -284,7 +295,9 @@ mod tests {
     use std::collections::HashMap;
 
     fn ids(n: usize) -> Vec<String> {
-        (0..n).map(|i| format!("r{}-deon7-full", 256 << (i % 6)) + &"x".repeat(i / 6)).collect()
+        (0..n)
+            .map(|i| format!("r{}-deon7-full", 256 << (i % 6)) + &"x".repeat(i / 6))
+            .collect()
     }
 
     fn env<'a>(pairs: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
@@ -333,9 +346,17 @@ mod tests {
         after.push("r128-deon7-full".into());
         for total in 1..=8 {
             for index in 1..=total {
-                let s = Shard { mode: Mode::Hash, index, total };
+                let s = Shard {
+                    mode: Mode::Hash,
+                    index,
+                    total,
+                };
                 let old: Vec<&String> = s.select(&before);
-                let new: Vec<&String> = s.select(&after).into_iter().filter(|id| before.contains(id)).collect();
+                let new: Vec<&String> = s
+                    .select(&after)
+                    .into_iter()
+                    .filter(|id| before.contains(id))
+                    .collect();
                 assert_eq!(old, new, "{s}");
             }
         }
@@ -349,7 +370,18 @@ mod tests {
         assert_eq!(parse("count:3/3").unwrap(), shard(Mode::Count, 3, 3));
         assert_eq!(parse("auto").unwrap(), Spec::Auto(Mode::Hash));
         assert_eq!(parse("count:auto").unwrap(), Spec::Auto(Mode::Count));
-        for bad in ["0/3", "4/3", "x/y", "1/0", "0/0", "3", "", "slice:1/2", "-1/3", "1/3/4"] {
+        for bad in [
+            "0/3",
+            "4/3",
+            "x/y",
+            "1/0",
+            "0/0",
+            "3",
+            "",
+            "slice:1/2",
+            "-1/3",
+            "1/3/4",
+        ] {
             match parse(bad) {
                 Err(e @ Error::Input(_)) => {
                     assert_eq!(e.exit_code(), 2);
@@ -371,7 +403,10 @@ mod tests {
         ];
         assert_eq!(shard_of(Some("auto"), &slurm), (2, 3, Mode::Hash));
         let r = resolved(Some("auto"), &slurm).unwrap().unwrap();
-        assert_eq!(r.to_string(), "shard 2/3 by id hash (from SLURM_ARRAY_TASK_ID=2)");
+        assert_eq!(
+            r.to_string(),
+            "shard 2/3 by id hash (from SLURM_ARRAY_TASK_ID=2)"
+        );
         let stepped = [
             ("SLURM_ARRAY_TASK_ID", "10"),
             ("SLURM_ARRAY_TASK_MIN", "0"),
@@ -395,8 +430,15 @@ mod tests {
         assert_eq!((r.shard.index, r.shard.total), (2, 4));
         assert_eq!(r.status_file.as_deref(), Some("/tmp/status"));
         // DERMIS_SHARD: read without --shard, and first under auto.
-        assert_eq!(shard_of(None, &[("DERMIS_SHARD", "count:2/5")]), (2, 5, Mode::Count));
-        let both = [("DERMIS_SHARD", "1/2"), ("CI_NODE_INDEX", "3"), ("CI_NODE_TOTAL", "3")];
+        assert_eq!(
+            shard_of(None, &[("DERMIS_SHARD", "count:2/5")]),
+            (2, 5, Mode::Count)
+        );
+        let both = [
+            ("DERMIS_SHARD", "1/2"),
+            ("CI_NODE_INDEX", "3"),
+            ("CI_NODE_TOTAL", "3"),
+        ];
         assert_eq!(shard_of(Some("count:auto"), &both), (1, 2, Mode::Count));
         // No flag, no DERMIS_SHARD: the whole sweep, whatever the scheduler says.
         assert_eq!(resolved(None, &slurm).unwrap(), None);
@@ -410,7 +452,10 @@ mod tests {
             ("SLURM_ARRAY_TASK_COUNT", "3"),
         ];
         let r = resolved(Some("count:1/2"), &env).unwrap().unwrap();
-        assert_eq!((r.shard.index, r.shard.total, r.shard.mode), (1, 2, Mode::Count));
+        assert_eq!(
+            (r.shard.index, r.shard.total, r.shard.mode),
+            (1, 2, Mode::Count)
+        );
         assert_eq!(r.source, "--shard");
     }
 
@@ -419,9 +464,21 @@ mod tests {
         let cases: &[&[(&str, &str)]] = &[
             &[],
             &[("SLURM_ARRAY_TASK_ID", "1")],
-            &[("SLURM_ARRAY_TASK_ID", "x"), ("SLURM_ARRAY_TASK_COUNT", "3")],
-            &[("SLURM_ARRAY_TASK_ID", "4"), ("SLURM_ARRAY_TASK_MIN", "1"), ("SLURM_ARRAY_TASK_COUNT", "3")],
-            &[("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_MIN", "0"), ("SLURM_ARRAY_TASK_STEP", "5"), ("SLURM_ARRAY_TASK_COUNT", "3")],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "x"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "4"),
+                ("SLURM_ARRAY_TASK_MIN", "1"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "2"),
+                ("SLURM_ARRAY_TASK_MIN", "0"),
+                ("SLURM_ARRAY_TASK_STEP", "5"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
             &[("JOB_COMPLETION_INDEX", "0")],
             &[("JOB_COMPLETION_INDEX", "3"), ("DERMIS_SHARD_TOTAL", "3")],
             &[("CI_NODE_INDEX", "0"), ("CI_NODE_TOTAL", "3")],
@@ -439,6 +496,9 @@ mod tests {
         // Without --shard a malformed DERMIS_SHARD is an error too.
         assert!(resolved(None, &[("DERMIS_SHARD", "4/3")]).is_err());
         let msg = resolved(Some("auto"), &[]).unwrap_err().to_string();
-        assert!(msg.contains("SLURM_ARRAY_TASK_ID") && msg.contains("--shard I/N"), "{msg}");
+        assert!(
+            msg.contains("SLURM_ARRAY_TASK_ID") && msg.contains("--shard I/N"),
+            "{msg}"
+        );
     }
 }
