@@ -259,3 +259,76 @@ pub fn completed(path: &Path, sweep_hash: &str) -> Result<Vec<Point>> {
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("dermis-log-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    const HEADER: &str = r#"{"record":"header","schema_version":1,"sweep_hash":"00000000000000aa","shard":"all","shard_points":["r256-deon7-full"],"sweep_points":["r256-deon7-full"],"run_id":"r","timestamp":"2026-11-25T10:00:00Z","dermis_version":"0","git_commit":"c","fingerprint":{"device":"d","device_type":"CPU","driver":"","api_version":"","cpu_model":"","cpu_cores":2,"lp_num_threads":null,"clock":"","validation":false},"reference_checksum":"0","reference":{"resolution":256,"kernel":"accurate","chain":"full"},"scene":"builtin","environment":"sky","width":1,"height":1,"frames":2}"#;
+    const POINT: &str = r#"{"record":"point","id":"r256-deon7-full","resolution":256,"kernel":"deon7","chain":"full","passes":[],"total_ms":1.0,"chain_ms":0.5,"frame_span":{"name":"frame","frames":0,"texels":null,"bytes":null,"ns_per_texel":null,"gb_per_s":null,"x_ruler":null},"transient_bytes":0,"final_error":{"rmse_rel":0.1,"max_rel":0.2,"p99_rel":0.15,"psnr_db":30.0,"pixels":4},"diffuse_error":{"rmse_rel":0.1,"max_rel":0.2,"p99_rel":0.15,"psnr_db":null,"pixels":4}}"#;
+
+    #[test]
+    fn reads_runs_and_skips_only_a_cut_last_line() {
+        let d = dir("read");
+        let path = d.join("points.jsonl");
+        // A second run appended after a first cut short inside its point.
+        let cut = &POINT[..40];
+        std::fs::write(&path, format!("{HEADER}\n{POINT}\n{HEADER}\n{cut}")).unwrap();
+        let mut warnings = Vec::new();
+        let runs = read(&path, &mut warnings).unwrap();
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0].points.len(), 1);
+        assert_eq!(runs[0].points[0].final_error.psnr_db, Some(30.0));
+        assert!(runs[1].points.is_empty());
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        // The same cut in the middle is an error naming the line.
+        std::fs::write(&path, format!("{HEADER}\n{cut}\n{POINT}\n")).unwrap();
+        let e = read(&path, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("points.jsonl:2"), "{e}");
+        // A point before any header, and no header at all.
+        std::fs::write(&path, format!("{POINT}\n")).unwrap();
+        assert!(read(&path, &mut Vec::new()).is_err());
+        std::fs::write(&path, "\n").unwrap();
+        assert!(read(&path, &mut Vec::new()).is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn resuming_cuts_the_incomplete_line_and_refuses_another_sweep() {
+        let d = dir("resume");
+        let path = d.join("points.jsonl");
+        std::fs::write(&path, format!("{HEADER}\n{POINT}\n{}", &POINT[..40])).unwrap();
+        assert_eq!(completed(&path, "00000000000000aa").unwrap().len(), 1);
+        let e = completed(&path, "00000000000000bb")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--resume") && e.contains("00000000000000aa"),
+            "{e}"
+        );
+        assert!(completed(&d.join("none.jsonl"), "x").unwrap().is_empty());
+        let header: Header = serde_json::from_str(HEADER).unwrap();
+        let point: Point = serde_json::from_str(POINT).unwrap();
+        let mut w = Writer::create(&path, &header, true).unwrap();
+        w.append(&point).unwrap();
+        drop(w);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.lines().count(), 4, "{text}");
+        let runs = read(&path, &mut Vec::new()).unwrap();
+        assert_eq!(
+            runs.iter().map(|r| r.points.len()).collect::<Vec<_>>(),
+            [1, 1]
+        );
+        // Without append the log starts over.
+        Writer::create(&path, &header, false).unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -55,3 +55,32 @@ pub fn write_all(sweep: &Sweep, dir: &Path) -> Result<()> {
     write_atomic(&dir.join("sweep.json"), &json(sweep)?)?;
     write_csv_and_plots(sweep, dir)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporaries_keep_the_extension_and_folder() {
+        let t = temporary(Path::new("out/sweep.json"));
+        assert_eq!(t.parent(), Some(Path::new("out")));
+        assert_eq!(t.extension().unwrap(), "json");
+        let name = t.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(name.starts_with(".sweep.tmp-"), "{name}");
+    }
+
+    #[test]
+    fn atomic_writes_leave_only_the_file() {
+        let d = std::env::temp_dir().join(format!("dermis-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        write_atomic(&d.join("a.csv"), "x\n").unwrap();
+        write_atomic(&d.join("a.csv"), "y\n").unwrap();
+        let names: Vec<String> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["a.csv"]);
+        assert_eq!(std::fs::read_to_string(d.join("a.csv")).unwrap(), "y\n");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}
