@@ -508,38 +508,13 @@ fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
     })?;
     let log = out_dir.join(shard.map_or_else(|| "points.jsonl".into(), |s| s.file_name()));
     let ctx = Context::new(context)?;
-    println!(
-        "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
-        "res",
-        "kernel",
-        "chain",
-        "frame ms",
-        "chain ms",
-        "ruler ns",
-        "final %",
-        "diffuse %",
-        "pool MiB"
-    );
+    println!("{}", sw::TABLE_HEADER);
     let how = sw::RunOptions {
         shard,
         log: Some(log.clone()),
         resume: args.resume,
     };
-    let sweep = sw::run(&ctx, &opts, &how, |p| {
-        let v = p.variant;
-        println!(
-            "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
-            v.resolution,
-            format!("{:?}", v.kernel).to_lowercase(),
-            format!("{:?}", v.chain).to_lowercase(),
-            p.total_ms,
-            p.chain_ms,
-            sw::ruler_ns_per_texel(p).unwrap_or(f64::NAN),
-            100.0 * p.final_error.rmse_rel,
-            100.0 * p.diffuse_error.rmse_rel,
-            p.transient_bytes as f64 / (1u64 << 20) as f64
-        );
-    })?;
+    let sweep = sw::run(&ctx, &opts, &how, |p| println!("{}", sw::table_row(p)))?;
     if shard.is_some() {
         println!(
             "wrote {} ({} points); merge the shards with `dermis sweep merge`",

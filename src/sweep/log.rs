@@ -234,8 +234,10 @@ pub fn read(path: &Path, warnings: &mut Vec<String>) -> Result<Vec<Segment>> {
 /// The points a log already holds for `sweep_hash` (for `--resume`); the last
 /// of several with one id. No log yet: none.
 pub fn completed(path: &Path, sweep_hash: &str) -> Result<Vec<Point>> {
-    if !path.exists() {
-        return Ok(Vec::new());
+    // No log, or one a killed run left empty: nothing done.
+    match std::fs::metadata(path) {
+        Ok(m) if m.len() > 0 => {}
+        _ => return Ok(Vec::new()),
     }
     let mut warnings = Vec::new();
     let segments = read(path, &mut warnings)?;

@@ -425,7 +425,34 @@ pub fn load(path: &std::path::Path) -> Result<Sweep> {
         path: path.display().to_string(),
         source,
     })?;
-    serde_json::from_str(&text).map_err(|e| Error::Input(format!("{}: {e}", path.display())))
+    let mut sweep: Sweep = serde_json::from_str(&text)
+        .map_err(|e| Error::Input(format!("{}: {e}", path.display())))?;
+    // Sweeps written before ids.
+    for p in sweep.points.iter_mut().filter(|p| p.id.is_empty()) {
+        p.id = p.variant.id();
+    }
+    Ok(sweep)
+}
+
+/// The table `dermis sweep` prints as points complete: its header…
+pub const TABLE_HEADER: &str = "   res kernel    chain       frame ms   chain ms  ruler ns   \
+final % diffuse %   pool MiB";
+
+/// …and a point's row.
+pub fn table_row(p: &Point) -> String {
+    let v = p.variant;
+    format!(
+        "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
+        v.resolution,
+        name(&v.kernel),
+        name(&v.chain),
+        p.total_ms,
+        p.chain_ms,
+        ruler_ns_per_texel(p).unwrap_or(f64::NAN),
+        100.0 * p.final_error.rmse_rel,
+        100.0 * p.diffuse_error.rmse_rel,
+        p.transient_bytes as f64 / (1u64 << 20) as f64
+    )
 }
 
 /// The ruler's ns/texel of a point (for tables).
