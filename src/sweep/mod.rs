@@ -3,6 +3,8 @@
 //! final image and the diffuse term with a reference (by default 4096², accurate
 //! kernel, full chain) over the face. Writes a CSV, a JSON and plots.
 
+pub mod atomic;
+pub mod hash;
 pub mod lighting;
 pub mod log;
 pub mod merge;
@@ -177,7 +179,7 @@ fn render(
 /// FNV-1a 64 over the reference's final then diffuse image, as f32 bytes in
 /// memory order (little-endian on every platform dermis runs on).
 pub fn reference_checksum(final_image: &[f32], diffuse: &[f32]) -> String {
-    points::hex(points::fnv1a64_parts([
+    hash::hex(hash::fnv1a64_parts([
         bytemuck::cast_slice::<f32, u8>(final_image),
         bytemuck::cast_slice::<f32, u8>(diffuse),
     ]))

@@ -2,7 +2,7 @@
 //! image's error, one series per kernel × chain; and the per-pass cost of every
 //! point as stacked bars.
 
-use super::output::{commit, temporary};
+use super::atomic::{commit, temporary};
 use super::{name, Point, Sweep};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;

@@ -2,6 +2,7 @@
 //! sweep hash: one number over everything that makes two runs' points
 //! comparable (and two shards' points parts of one sweep).
 
+use super::hash::{fnv1a64, hex};
 use super::shard::Shard;
 use super::{name, SweepOptions, Variant};
 use crate::scene::file::{Chain, Kernel};
@@ -10,28 +11,6 @@ use serde::Serialize;
 /// Bumped whenever the meaning of a point, its id, the JSONL records or the
 /// hashed key changes; part of the sweep hash, and checked by `sweep merge`.
 pub const SWEEP_SCHEMA_VERSION: u32 = 1;
-
-/// FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3): a
-/// hash whose value is fixed by its definition, unlike `DefaultHasher`'s.
-pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
-/// FNV-1a 64 over several byte strings in turn (as if concatenated).
-pub fn fnv1a64_parts<'a>(parts: impl IntoIterator<Item = &'a [u8]>) -> u64 {
-    parts.into_iter().fold(0xcbf2_9ce4_8422_2325, |h, bytes| {
-        bytes.iter().fold(h, |h, &b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-        })
-    })
-}
-
-/// 16 lower-case hex digits.
-pub fn hex(h: u64) -> String {
-    format!("{h:016x}")
-}
 
 impl Variant {
     /// `r1024-deon7-adaptive`: from the parameters only, so a point keeps its id
@@ -169,14 +148,6 @@ mod tests {
             frames: 3,
             reference_resolution: 2048,
         }
-    }
-
-    #[test]
-    fn fnv1a64_matches_its_published_vectors() {
-        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
-        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
-        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
-        assert_eq!(fnv1a64_parts([&b"foo"[..], b"bar"]), fnv1a64(b"foobar"));
     }
 
     #[test]
