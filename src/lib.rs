@@ -3,6 +3,7 @@
 //! measured pass by pass.
 
 pub mod assets;
+pub mod atomic;
 pub mod error;
 pub mod frame;
 pub mod gpu;

@@ -120,52 +120,12 @@ enum Command {
     /// Time against quality: render every irradiance resolution × blur kernel ×
     /// diffusion chain with the rulers and compare each final image and diffuse
     /// term with a reference over the face (RMSE and max relative to the mean,
-    /// 99th percentile, PSNR). Writes sweep.csv, sweep.json, time_vs_error.{svg,png}
-    /// and passes.{svg,png} into --out-dir (docs/performance.md).
-    #[command(after_help = AFTER_HELP)]
-    Sweep {
-        /// Scene file, or `builtin`; default: assets/default.toml. Its skybox is
-        /// turned off: the face mask is the image's alpha.
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        /// Irradiance resolutions (powers of two, 256..8192), comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
-        resolutions: Vec<u32>,
-        /// Blur kernels, comma-separated.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "deon7,accurate"
-        )]
-        kernels: Vec<Kernel>,
-        /// Diffusion chains, comma-separated.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "full,adaptive"
-        )]
-        chains: Vec<Chain>,
-        /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
-        #[arg(long, default_value_t = 4)]
-        frames: u32,
-        /// Irradiance resolution of the reference (accurate kernel, full chain).
-        #[arg(long, default_value_t = 4096)]
-        reference_resolution: u32,
-        /// Output width in pixels, replacing the scene's.
-        #[arg(long)]
-        width: Option<u32>,
-        /// Output height in pixels, replacing the scene's.
-        #[arg(long)]
-        height: Option<u32>,
-        /// Directory for the CSV, JSON and plots (created).
-        #[arg(long, default_value = "sweep")]
-        out_dir: PathBuf,
-        /// Render nothing: redraw the plots and CSV of --out-dir from its sweep.json.
-        #[arg(long)]
-        replot: bool,
-    },
+    /// 99th percentile, PSNR). Writes points.jsonl, sweep.csv, sweep.json,
+    /// time_vs_error.{svg,png} and passes.{svg,png} into --out-dir; with --shard,
+    /// only this shard's points-shard-I-of-N.jsonl, for `dermis sweep merge`
+    /// (docs/performance.md, docs/recipes/).
+    #[command(after_help = AFTER_HELP, args_conflicts_with_subcommands = true)]
+    Sweep(SweepArgs),
     /// Lighting against the truth: for each environment, the direct term
     /// (`--view direct`, grey albedo) with the paper's SH9 alone and with the
     /// bright sources extracted as shadowed lights, each against the CPU
@@ -271,7 +231,8 @@ enum Command {
         /// The new side's render options (e.g. "--irradiance-res 1024 --kernel accurate").
         #[arg(long, default_value = "", allow_hyphen_values = true)]
         new_args: String,
-        /// Where the runs' reports (base-K.json, new-K.json) and images go (created).
+        /// Where the runs' reports (base/run-K.json, new/run-K.json: `dermis
+        /// compare DIR/base DIR/new` compares them again) and images go (created).
         #[arg(long, default_value = "interleave")]
         out_dir: PathBuf,
         #[command(flatten)]
@@ -452,6 +413,93 @@ struct DecideArgs {
     fail_on_regression: bool,
 }
 
+#[derive(clap::Args)]
+struct SweepArgs {
+    #[command(subcommand)]
+    command: Option<SweepCommand>,
+    /// Scene file, or `builtin`; default: assets/default.toml. Its skybox is
+    /// turned off: the face mask is the image's alpha.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Irradiance resolutions (powers of two, 256..8192), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "256,512,1024,2048,4096")]
+    resolutions: Vec<u32>,
+    /// Blur kernels, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "deon7,accurate"
+    )]
+    kernels: Vec<Kernel>,
+    /// Diffusion chains, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "full,adaptive"
+    )]
+    chains: Vec<Chain>,
+    /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
+    #[arg(long, default_value_t = 4)]
+    frames: u32,
+    /// Irradiance resolution of the reference (accurate kernel, full chain).
+    #[arg(long, default_value_t = 4096)]
+    reference_resolution: u32,
+    /// Output width in pixels, replacing the scene's.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Output height in pixels, replacing the scene's.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Directory for the CSV, JSON and plots (created).
+    #[arg(long, default_value = "sweep")]
+    out_dir: PathBuf,
+    /// Render nothing: redraw the plots and CSV of --out-dir from its sweep.json.
+    #[arg(long)]
+    replot: bool,
+    /// Render only this shard of the points: I/N (1-based; same as hash:I/N, by a
+    /// hash of each point's id, stable as points are added), count:I/N (every
+    /// N-th point from the I-th: balanced), or auto (from Slurm, Kubernetes,
+    /// GitLab, Bazel or DERMIS_SHARD; see docs/performance.md). Without it,
+    /// DERMIS_SHARD (same syntax) is read. Writes points-shard-I-of-N.jsonl
+    /// into --out-dir; merge with `dermis sweep merge`.
+    #[arg(long, value_name = "I/N|hash:I/N|count:I/N|auto")]
+    shard: Option<String>,
+    /// Render nothing: print the points (id, resolution, kernel, chain) in
+    /// canonical order and the sweep hash.
+    #[arg(long)]
+    list_points: bool,
+    /// With --list-points: print JSON.
+    #[arg(long, requires = "list_points")]
+    json: bool,
+    /// Skip the points already in --out-dir's log for this sweep (same sweep
+    /// hash), appending the rest to it.
+    #[arg(long)]
+    resume: bool,
+}
+
+#[derive(Subcommand)]
+enum SweepCommand {
+    /// Merge the points logs (*.jsonl) of a sharded sweep into sweep.json,
+    /// sweep.csv and the plots, as an unsharded sweep writes them. Every point
+    /// must appear; of duplicates the later run's is kept (header timestamp,
+    /// then argument and file-name order, then line order).
+    #[command(after_help = AFTER_HELP)]
+    Merge {
+        /// Folders (their *.jsonl) or files.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Where to write; default: the first input folder.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// Merge even when the shards' reference images differ (their errors
+        /// are then against different images).
+        #[arg(long)]
+        allow_reference_mismatch: bool,
+    },
+}
+
 /// `--background R,G,B`.
 fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
     let v: Vec<f32> = s
@@ -468,11 +516,115 @@ fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String>
         .map_err(|e| dermis::Error::Input(format!("{}: {e}", path.display())))
 }
 
+/// Whole or not at all: a temporary file renamed into place.
 fn write_file(path: &Path, text: &str) -> dermis::Result<()> {
-    std::fs::write(path, text).map_err(|source| dermis::Error::Io {
-        path: path.display().to_string(),
+    dermis::atomic::write_atomic(path, text)
+}
+
+/// `dermis sweep` and `dermis sweep merge`.
+fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
+    use dermis::sweep::{self as sw, output};
+    if let Some(SweepCommand::Merge {
+        inputs,
+        out_dir,
+        allow_reference_mismatch,
+    }) = args.command
+    {
+        let merged = sw::merge::merge(
+            &inputs,
+            sw::merge::MergeOptions {
+                allow_reference_mismatch,
+            },
+        )?;
+        for w in &merged.warnings {
+            eprintln!("warning: {w}");
+        }
+        let out_dir = out_dir.unwrap_or_else(|| sw::merge::default_out_dir(&inputs));
+        output::write_all(&merged.sweep, &out_dir)?;
+        println!(
+            "merged {} points from {} run(s) into {}",
+            merged.sweep.points.len(),
+            merged.sweep.shards.len(),
+            out_dir.display()
+        );
+        return Ok(());
+    }
+    let out_dir = args.out_dir;
+    if args.replot {
+        let sweep = sw::load(&out_dir.join("sweep.json"))?;
+        output::write_csv_and_plots(&sweep, &out_dir)?;
+        println!("redrew {}", out_dir.display());
+        return Ok(());
+    }
+    let file = Overrides {
+        width: args.width,
+        height: args.height,
+        ..Overrides::default()
+    }
+    .apply(scene_by_name(args.scene.as_deref())?)?;
+    let opts = sw::SweepOptions {
+        scene: file,
+        scene_label: args
+            .scene
+            .unwrap_or_else(default_scene_path)
+            .display()
+            .to_string(),
+        resolutions: args.resolutions,
+        kernels: args.kernels,
+        chains: args.chains,
+        frames: args.frames,
+        reference_resolution: args.reference_resolution,
+    };
+    sw::validate(&opts)?;
+    let env = |k: &str| std::env::var(k).ok();
+    let resolved = sw::shard::resolve(args.shard.as_deref(), &env)?;
+    if let Some(r) = &resolved {
+        eprintln!("{r}");
+    }
+    let shard = resolved.as_ref().map(|r| r.shard);
+    if args.list_points {
+        let list = sw::points::list(&opts, shard);
+        if args.json {
+            println!("{}", to_json(Path::new("stdout"), &list)?);
+        } else {
+            for p in &list.points {
+                println!("{}", p.id);
+            }
+            println!(
+                "sweep hash {} ({} points)",
+                list.sweep_hash,
+                list.points.len()
+            );
+        }
+        return Ok(());
+    }
+    if let Some(r) = &resolved {
+        sw::shard::acknowledge(r)?;
+    }
+    std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
+        path: out_dir.display().to_string(),
         source,
-    })
+    })?;
+    let log = out_dir.join(shard.map_or_else(|| "points.jsonl".into(), |s| s.file_name()));
+    let ctx = Context::new(context)?;
+    println!("{}", sw::TABLE_HEADER);
+    let how = sw::RunOptions {
+        shard,
+        log: Some(log.clone()),
+        resume: args.resume,
+    };
+    let sweep = sw::run(&ctx, &opts, &how, |p| println!("{}", sw::table_row(p)))?;
+    if shard.is_some() {
+        println!(
+            "wrote {} ({} points); merge the shards with `dermis sweep merge`",
+            log.display(),
+            sweep.points.len()
+        );
+    } else {
+        output::write_all(&sweep, &out_dir)?;
+        println!("wrote {}", out_dir.display());
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -674,83 +826,7 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Command::Sweep {
-            scene,
-            resolutions,
-            kernels,
-            chains,
-            frames,
-            reference_resolution,
-            width,
-            height,
-            out_dir,
-            replot,
-        } => {
-            if replot {
-                let sweep = dermis::sweep::load(&out_dir.join("sweep.json"))?;
-                write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
-                dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
-                println!("redrew {}", out_dir.display());
-                return Ok(ExitCode::SUCCESS);
-            }
-            let file = Overrides {
-                width,
-                height,
-                ..Overrides::default()
-            }
-            .apply(scene_by_name(scene.as_deref())?)?;
-            let opts = dermis::sweep::SweepOptions {
-                scene: file,
-                scene_label: scene
-                    .unwrap_or_else(default_scene_path)
-                    .display()
-                    .to_string(),
-                resolutions,
-                kernels,
-                chains,
-                frames,
-                reference_resolution,
-            };
-            dermis::sweep::validate(&opts)?;
-            std::fs::create_dir_all(&out_dir).map_err(|source| dermis::Error::Io {
-                path: out_dir.display().to_string(),
-                source,
-            })?;
-            let ctx = Context::new(&context)?;
-            println!(
-                "{:>6} {:<9} {:<9} {:>10} {:>10} {:>9} {:>9} {:>9} {:>10}",
-                "res",
-                "kernel",
-                "chain",
-                "frame ms",
-                "chain ms",
-                "ruler ns",
-                "final %",
-                "diffuse %",
-                "pool MiB"
-            );
-            let sweep = dermis::sweep::run(&ctx, &opts, |p| {
-                let v = p.variant;
-                println!(
-                    "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
-                    v.resolution,
-                    format!("{:?}", v.kernel).to_lowercase(),
-                    format!("{:?}", v.chain).to_lowercase(),
-                    p.total_ms,
-                    p.chain_ms,
-                    dermis::sweep::ruler_ns_per_texel(p).unwrap_or(f64::NAN),
-                    100.0 * p.final_error.rmse_rel,
-                    100.0 * p.diffuse_error.rmse_rel,
-                    p.transient_bytes as f64 / (1u64 << 20) as f64
-                );
-            })?;
-            let json = out_dir.join("sweep.json");
-            write_file(&json, &to_json(&json, &sweep)?)?;
-            write_file(&out_dir.join("sweep.csv"), &dermis::sweep::csv(&sweep))?;
-            dermis::sweep::plot::write_plots(&sweep, &out_dir)?;
-            println!("wrote {}", out_dir.display());
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Sweep(args) => sweep(args, &context).map(|()| ExitCode::SUCCESS),
         Command::Reference {
             scene,
             envs,
@@ -834,12 +910,30 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
             })?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Compare { base, new, decide } => {
-            let (base, mut warnings) = load_side(&base)?;
-            let (new, more) = load_side(&new)?;
-            warnings.extend(more);
-            report_comparison(&base, &new, &decide, warnings)
-        }
+        Command::Compare { base, new, decide } => match (load_side(&base)?, load_side(&new)?) {
+            (Side::Runs(base, w1), Side::Runs(new, w2)) => {
+                report_comparison(&[(String::new(), base, new)], &decide, [w1, w2].concat())
+            }
+            (Side::Sweep(base), Side::Sweep(mut new)) => {
+                let mut warnings = Vec::new();
+                let mut pairs = Vec::new();
+                for (id, b) in base {
+                    match new.iter().position(|(n, _)| *n == id) {
+                        Some(i) => pairs.push((id, b, new.remove(i).1)),
+                        None => warnings.push(format!("point {id} is only in the base")),
+                    }
+                }
+                warnings.extend(
+                    new.iter()
+                        .map(|(id, _)| format!("point {id} is only in the new sweep")),
+                );
+                report_comparison(&pairs, &decide, warnings)
+            }
+            _ => Err(dermis::Error::Input(
+                "compare: give two reports (or folders of them) or two sweeps, not one of each"
+                    .into(),
+            )),
+        },
         Command::Interleave {
             runs,
             frames,
@@ -859,7 +953,11 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
                 ("new", new_bin.unwrap_or(me), new_args),
             ];
             let [base, new] = interleave(&sides, runs, frames, &out_dir)?;
-            report_comparison(&base.0, &new.0, &decide, [base.1, new.1].concat())
+            report_comparison(
+                &[(String::new(), base.0, new.0)],
+                &decide,
+                [base.1, new.1].concat(),
+            )
         }
         Command::Export {
             report,
@@ -1036,8 +1134,15 @@ fn read_text(path: &Path) -> dermis::Result<String> {
     })
 }
 
-/// One side of `compare`: a report, or a folder of reports pooled as runs.
-fn load_side(path: &Path) -> dermis::Result<(Measurement, Vec<String>)> {
+/// One side of `compare`.
+enum Side {
+    /// A report, or a folder of reports pooled as runs; warnings of pooling.
+    Runs(Measurement, Vec<String>),
+    /// A sweep's points by id.
+    Sweep(Vec<(String, Measurement)>),
+}
+
+fn load_side(path: &Path) -> dermis::Result<Side> {
     let files = if path.is_dir() {
         let mut files: Vec<PathBuf> = std::fs::read_dir(path)
             .map_err(|source| dermis::Error::Io {
@@ -1058,6 +1163,14 @@ fn load_side(path: &Path) -> dermis::Result<(Measurement, Vec<String>)> {
     } else {
         vec![path.to_path_buf()]
     };
+    let text = read_text(&files[0])?;
+    if files.len() == 1 && text.contains("\"points\"") && !text.contains("\"per_frame\"") {
+        let sweep = dermis::sweep::load(&files[0])?;
+        let source = files[0].display().to_string();
+        return Ok(Side::Sweep(dermis::sweep::compare::measurements(
+            &sweep, &source,
+        )?));
+    }
     let parts = files
         .iter()
         .map(|f| Measurement::from_report_json(&read_text(f)?, &f.display().to_string()))
@@ -1066,14 +1179,14 @@ fn load_side(path: &Path) -> dermis::Result<(Measurement, Vec<String>)> {
     if files.len() > 1 {
         m.source = format!("{} ({} reports)", path.display(), files.len());
     }
-    Ok((m, warnings))
+    Ok(Side::Runs(m, warnings))
 }
 
-/// Compares, prints the table (or JSON), writes the JUnit file; status 3 on
-/// a regression when asked.
+/// Compares each pair (a sweep's points by id; a report's one pair with no
+/// label), prints the tables (or JSON), writes the JUnit file; status 3 on a
+/// regression when asked.
 fn report_comparison(
-    base: &Measurement,
-    new: &Measurement,
+    pairs: &[(String, Measurement, Measurement)],
     decide: &DecideArgs,
     warnings: Vec<String>,
 ) -> dermis::Result<ExitCode> {
@@ -1083,17 +1196,52 @@ fn report_comparison(
         significance: decide.significance,
         allow_setup_change: decide.allow_setup_change,
     };
-    let mut c: Comparison = compare::compare(base, new, &opts)?;
-    c.warnings.splice(0..0, warnings);
+    if pairs.is_empty() {
+        return Err(dermis::Error::Input(format!(
+            "compare: nothing in common to compare ({})",
+            warnings.join("; ")
+        )));
+    }
+    let mut results: Vec<(String, Comparison)> = Vec::new();
+    for (label, base, new) in pairs {
+        results.push((label.clone(), compare::compare(base, new, &opts)?));
+    }
+    if let [(label, c)] = results.as_mut_slice() {
+        if label.is_empty() {
+            c.warnings.splice(0..0, warnings.iter().cloned());
+        }
+    }
+    let single = results.len() == 1 && results[0].0.is_empty();
     if decide.json {
-        println!("{}", to_json(Path::new("stdout"), &c)?);
+        let value = if single {
+            serde_json::to_value(&results[0].1)
+        } else {
+            serde_json::to_value(serde_json::json!({
+                "warnings": warnings,
+                "points": results.iter().map(|(id, c)| serde_json::json!({"id": id, "comparison": c})).collect::<Vec<_>>(),
+            }))
+        }
+        .map_err(|e| dermis::Error::Input(e.to_string()))?;
+        println!("{}", to_json(Path::new("stdout"), &value)?);
     } else {
-        print!("{}", compare::table(&c));
+        if !single {
+            for w in &warnings {
+                println!("warning: {w}");
+            }
+        }
+        for (label, c) in &results {
+            if !label.is_empty() {
+                println!("\n== point {label}");
+            }
+            print!("{}", compare::table(c));
+        }
     }
+    let comparisons: Vec<&Comparison> = results.iter().map(|(_, c)| c).collect();
     if let Some(path) = &decide.junit {
-        write_file(path, &dermis::profile::export::junit(&c))?;
+        write_file(path, &dermis::profile::export::junit(&comparisons))?;
     }
-    Ok(if decide.fail_on_regression && c.regressed() {
+    let regressed = comparisons.iter().any(|c| c.regressed());
+    Ok(if decide.fail_on_regression && regressed {
         ExitCode::from(3)
     } else {
         ExitCode::SUCCESS
@@ -1140,17 +1288,20 @@ fn interleave(
         }
         args.push(a);
     }
-    std::fs::create_dir_all(out_dir).map_err(|source| dermis::Error::Io {
-        path: out_dir.display().to_string(),
-        source,
-    })?;
+    for (name, _, _) in sides {
+        let dir = out_dir.join(name);
+        std::fs::create_dir_all(&dir).map_err(|source| dermis::Error::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+    }
     let mut files: [Vec<PathBuf>; 2] = [Vec::new(), Vec::new()];
     for k in 0..runs {
         // A B, then B A: a linear drift falls on both sides alike.
         let order = if k % 2 == 0 { [0, 1] } else { [1, 0] };
         for i in order {
             let (name, bin, _) = &sides[i];
-            let report = out_dir.join(format!("{name}-{k:03}.json"));
+            let report = out_dir.join(name).join(format!("run-{k:03}.json"));
             let started = std::time::Instant::now();
             let status = std::process::Command::new(bin)
                 .arg("render")

@@ -225,7 +225,7 @@ fn interleave_alternates_processes_and_compares() {
         .any(|p| p["name"] == "skin"));
     for k in 0..2 {
         for side in ["base", "new"] {
-            let report = dir.join(format!("{side}-{k:03}.json"));
+            let report = dir.join(side).join(format!("run-{k:03}.json"));
             assert!(report.is_file(), "{}", report.display());
         }
     }

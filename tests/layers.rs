@@ -18,7 +18,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "graph"],
     &["profile"],
     &["gpu"],
-    &["error", "assets", "text"],
+    &["error", "assets", "atomic", "text"],
 ];
 
 fn layer_of(module: &str) -> usize {

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """A/A noise and power of `dermis compare` (docs/performance.md, "Comparing runs").
 
-Reads the groups aa-runs.sh wrote (g0.json, g1.json, ...; each RUNS identical
-runs) and compares them in disjoint pairs (g0 vs g1, g2 vs g3, ...):
+Reads the pairs aa-interleave.sh wrote (pairK/base/run-*.json and
+pairK/new/run-*.json: the same render, RUNS processes a side, interleaved) and
+compares each pair's sides:
 
 1. the |change| of every pass in A/A pairs: its 95th percentile over the first
    half of the pairs is the noise threshold it suggests;
@@ -10,7 +11,7 @@ runs) and compares them in disjoint pairs (g0 vs g1, g2 vs g3, ...):
    improved, over the second half (threshold from the first) and over all pairs
    at the default threshold;
 3. the smallest change found: the B side's pass PASS scaled by 1 + d in every
-   frame, for N runs per side (the first N of each group), the share of pairs in
+   frame, for N runs per side (the first N of each side), the share of pairs in
    which `dermis compare` calls PASS regressed.
 
 Usage: aa-analyse.py DIR [--pass blur3_u] [--runs 5,10] [--shifts 2,3,5,10,20]
@@ -22,6 +23,7 @@ import argparse
 import glob
 import json
 import os
+import shutil
 import subprocess
 import tempfile
 
@@ -38,19 +40,19 @@ def compare(a, b, *extra):
     return json.loads(out.stdout)
 
 
-def subset(report, runs, scale_pass=None, scale=1.0, tag=""):
-    """The report with only its first `runs` runs, PASS scaled; a temp path."""
-    r = json.loads(json.dumps(report))
-    r["per_frame"] = [f for f in r["per_frame"] if f.get("run", 0) < runs]
-    for f in r["per_frame"]:
-        for p in f["passes"]:
-            if p["name"] == scale_pass and p.get("gpu_ns") is not None:
-                p["gpu_ns"] *= scale
-    r["run_id"] = r["run_id"] + tag
-    fd, path = tempfile.mkstemp(suffix=".json")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(r, fh)
-    return path
+def side_copy(files, runs, scale_pass=None, scale=1.0):
+    """The first `runs` reports of a side, PASS scaled; a temp folder."""
+    folder = tempfile.mkdtemp()
+    for path in files[:runs]:
+        with open(path) as fh:
+            r = json.load(fh)
+        for f in r["per_frame"]:
+            for p in f["passes"]:
+                if p["name"] == scale_pass and p.get("gpu_ns") is not None:
+                    p["gpu_ns"] *= scale
+        with open(os.path.join(folder, os.path.basename(path)), "w") as fh:
+            json.dump(r, fh)
+    return folder
 
 
 def percentile(v, q):
@@ -65,15 +67,15 @@ def main():
     ap.add_argument("--runs", default="5,10")
     ap.add_argument("--shifts", default="2,3,5,10,20")
     args = ap.parse_args()
-    files = sorted(
-        glob.glob(os.path.join(args.dir, "g*.json")),
-        key=lambda p: int(os.path.basename(p)[1:-5]),
+    pairs = sorted(
+        (os.path.join(d, "base"), os.path.join(d, "new"))
+        for d in glob.glob(os.path.join(args.dir, "pair*"))
+        if os.path.isdir(d)
     )
-    pairs = [(files[i], files[i + 1]) for i in range(0, len(files) - 1, 2)]
-    print(f"{len(pairs)} A/A pairs from {len(files)} groups in {args.dir}")
+    print(f"{len(pairs)} A/A pairs in {args.dir}")
     results = [compare(a, b) for a, b in pairs]
-    unit = results[0]["passes"][0]["unit"]
-    print(f"unit chosen (auto): {unit}; samples per side: {results[0]['passes'][0]['base_samples']} runs")
+    units = {c["passes"][0]["unit"] for c in results}
+    print(f"unit chosen (auto): {sorted(units)}; samples per side: {results[0]['passes'][0]['base_samples']} runs")
 
     judged = lambda c: [p for p in c["passes"] if not p["ruler"]]
     changes = lambda cs: [abs(p["change"]) for c in cs for p in judged(c) if p["change"] is not None]
@@ -98,22 +100,22 @@ def main():
     n, total = alarms(held_out)
     print(f"threshold {100 * calib:.2f} %, held-out pairs: {n}/{total} with a false alarm")
 
-    reports = [(json.load(open(a)), json.load(open(b))) for a, b in pairs]
+    side = lambda d: sorted(glob.glob(os.path.join(d, "*.json")))
     print(f"\npower: share of pairs in which {args.pass_} × (1 + d) is called regressed")
     print("runs  " + "  ".join(f"{d:>5}%" for d in args.shifts.split(",")))
     for runs in [int(x) for x in args.runs.split(",")]:
         row = []
         for d in [float(x) for x in args.shifts.split(",")]:
             found = 0
-            for i, (ra, rb) in enumerate(reports):
-                a = subset(ra, runs, tag=f"-a{i}")
-                b = subset(rb, runs, args.pass_, 1 + d / 100, tag=f"-b{i}")
-                c = compare(a, b)
-                os.remove(a)
-                os.remove(b)
+            for a, b in pairs:
+                fa = side_copy(side(a), runs)
+                fb = side_copy(side(b), runs, args.pass_, 1 + d / 100)
+                c = compare(fa, fb)
+                shutil.rmtree(fa)
+                shutil.rmtree(fb)
                 p = next(p for p in c["passes"] if p["name"] == args.pass_)
                 found += p["verdict"] == "regressed"
-            row.append(f"{100 * found / len(reports):>5.0f}%")
+            row.append(f"{100 * found / len(pairs):>5.0f}%")
         print(f"{runs:>4}  " + "  ".join(row))
 
 

@@ -7,7 +7,7 @@ pub const HEADER: &str = "run_id,run,frame,warmup,pass,start_ns,duration_ns,cloc
 scene,environment,irradiance_resolution,kernel,chain,view,width,height,device,git_commit";
 
 /// RFC 4180 quoting where a field needs it.
-fn field(s: &str) -> String {
+pub fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

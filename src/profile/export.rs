@@ -66,54 +66,57 @@ pub fn bencher(r: &RunReport) -> Value {
     Value::Object(out)
 }
 
-/// JUnit XML: a test suite of one test case per compared pass (rulers left
-/// out), failed where it regressed; improved, unchanged and inconclusive
-/// passes pass, with the verdict in their system-out.
-pub fn junit(c: &Comparison) -> String {
-    let judged: Vec<_> = c.passes.iter().filter(|p| !p.ruler).collect();
-    let failures = judged
-        .iter()
-        .filter(|p| p.verdict == Verdict::Regressed)
-        .count();
+/// JUnit XML: a test suite per comparison (a sweep's point, or the one
+/// comparison of two reports) of one test case per compared pass (rulers left
+/// out), failed where it regressed; improved, unchanged and inconclusive passes
+/// pass, with the verdict in their system-out.
+pub fn junit(comparisons: &[&Comparison]) -> String {
+    let judged = |c: &Comparison| c.passes.iter().filter(|p| !p.ruler).count();
+    let failed = |c: &Comparison| c.count(Verdict::Regressed);
     let pct = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:+.2}%", 100.0 * v));
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     s += &format!(
-        "<testsuites name=\"dermis compare\" tests=\"{}\" failures=\"{failures}\">\n",
-        judged.len()
+        "<testsuites name=\"dermis compare\" tests=\"{}\" failures=\"{}\">\n",
+        comparisons.iter().map(|c| judged(c)).sum::<usize>(),
+        comparisons.iter().map(|c| failed(c)).sum::<usize>()
     );
-    s += &format!(
-        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{failures}\">\n",
-        xml(&format!("{} vs {}", c.base, c.new)),
-        judged.len()
-    );
-    for p in judged {
-        let summary = format!(
-            "{}: change {} (95% CI [{}, {}]) in {} units, p = {:.3e} (Holm {:.3e}), {} vs {} {}s",
-            p.verdict.name(),
-            pct(p.change),
-            pct(p.ci_low),
-            pct(p.ci_high),
-            p.unit,
-            p.p,
-            p.p_holm,
-            p.base_samples,
-            p.new_samples,
-            p.sample
-        );
+    for c in comparisons {
         s += &format!(
-            "    <testcase classname=\"dermis.passes\" name=\"{}\">\n",
-            xml(&p.name)
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\">\n",
+            xml(&format!("{} vs {}", c.base, c.new)),
+            judged(c),
+            failed(c)
         );
-        if p.verdict == Verdict::Regressed {
-            s += &format!(
-                "      <failure message=\"{}\" type=\"regression\"/>\n",
-                xml(&summary)
+        for p in c.passes.iter().filter(|p| !p.ruler) {
+            let summary = format!(
+                "{}: change {} (95% CI [{}, {}]) in {} units, p = {:.3e} (Holm {:.3e}), {} vs {} {}s",
+                p.verdict.name(),
+                pct(p.change),
+                pct(p.ci_low),
+                pct(p.ci_high),
+                p.unit,
+                p.p,
+                p.p_holm,
+                p.base_samples,
+                p.new_samples,
+                p.sample
             );
+            s += &format!(
+                "    <testcase classname=\"dermis.passes\" name=\"{}\">\n",
+                xml(&p.name)
+            );
+            if p.verdict == Verdict::Regressed {
+                s += &format!(
+                    "      <failure message=\"{}\" type=\"regression\"/>\n",
+                    xml(&summary)
+                );
+            }
+            s += &format!("      <system-out>{}</system-out>\n", xml(&summary));
+            s += "    </testcase>\n";
         }
-        s += &format!("      <system-out>{}</system-out>\n", xml(&summary));
-        s += "    </testcase>\n";
+        s += "  </testsuite>\n";
     }
-    s += "  </testsuite>\n</testsuites>\n";
+    s += "</testsuites>\n";
     s
 }
 
@@ -169,7 +172,7 @@ mod tests {
             ..Default::default()
         };
         let c = compare(&side(1.0, "a"), &side(1.5, "b"), &CompareOptions::default()).unwrap();
-        let x = junit(&c);
+        let x = junit(&[&c]);
         // blur and the frame's sum regressed, skin did not.
         assert!(x.contains("tests=\"3\" failures=\"2\""), "{x}");
         assert!(x.contains("&lt;a&gt; vs &lt;b&gt;"), "{x}");

@@ -3,18 +3,30 @@
 //! final image and the diffuse term with a reference (by default 4096², accurate
 //! kernel, full chain) over the face. Writes a CSV, a JSON and plots.
 
+pub mod compare;
+pub mod hash;
 pub mod lighting;
+pub mod log;
+pub mod merge;
 pub mod metric;
+pub mod output;
 pub mod plot;
+pub mod points;
+pub mod shard;
 
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::profile::{PassStats, RunReport, GIT_COMMIT, RULER_COPY, VERSION};
+use crate::profile::csv::field;
+use crate::profile::fingerprint::{run_id, timestamp};
+use crate::profile::{Fingerprint, PassStats, RunReport, GIT_COMMIT, RULER_COPY, VERSION};
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::file::{Chain, Kernel, SceneFile};
 use crate::scene::Scene;
 use metric::{compare, coverage_mask, ImageError};
+use points::SWEEP_SCHEMA_VERSION;
 use serde::{Deserialize, Serialize};
+use shard::Shard;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// What to sweep.
@@ -33,7 +45,7 @@ pub struct SweepOptions {
 }
 
 /// The resolution, kernel and chain of one render.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Variant {
     pub resolution: u32,
     pub kernel: Kernel,
@@ -43,9 +55,13 @@ pub struct Variant {
 /// One point of the sweep.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Point {
+    /// `r1024-deon7-adaptive` ([`Variant::id`]); empty in sweeps written before ids.
+    #[serde(default)]
+    pub id: String,
     #[serde(flatten)]
     pub variant: Variant,
-    /// Per pass over the measured frames, rulers included.
+    /// Per pass over the measured frames, rulers included (with each measured
+    /// frame's sample).
     pub passes: Vec<PassStats>,
     /// Sum of the pass medians without the rulers: the frame's cost.
     pub total_ms: f64,
@@ -58,18 +74,56 @@ pub struct Point {
     pub diffuse_error: ImageError,
 }
 
+/// Where a merged sweep's points came from: one run (a shard, or a resumed
+/// part of one) of `sweep merge`'s inputs.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShardRun {
+    pub file: String,
+    /// `hash:2/3`, or `all` for an unsharded run.
+    pub shard: String,
+    pub run_id: String,
+    pub timestamp: String,
+    pub fingerprint: Fingerprint,
+    pub reference_checksum: String,
+    /// Ids of the points taken from this run (after de-duplication).
+    pub points: Vec<String>,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Sweep {
+    /// [`SWEEP_SCHEMA_VERSION`]; 0 in sweeps written before it.
+    #[serde(default)]
+    pub schema_version: u32,
+    /// [`points::sweep_hash`]: equal hashes, comparable points.
+    #[serde(default)]
+    pub sweep_hash: String,
+    /// This run's (or, merged, the merge's) id and UTC start time.
+    #[serde(default)]
+    pub run_id: String,
+    #[serde(default)]
+    pub timestamp: String,
     pub dermis_version: String,
     pub git_commit: String,
     pub device: String,
     pub driver: String,
+    /// Merged: the first input's (differences are warned about).
+    #[serde(default)]
+    pub fingerprint: Fingerprint,
     pub scene: String,
+    /// The scene's environment source.
+    #[serde(default)]
+    pub environment: String,
     pub width: u32,
     pub height: u32,
     pub frames: u32,
     pub reference: Variant,
+    /// FNV-1a 64 of the reference's final and diffuse HDR images (f32 bytes).
+    #[serde(default)]
+    pub reference_checksum: String,
     pub points: Vec<Point>,
+    /// Merged sweeps: the runs the points came from.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shards: Vec<ShardRun>,
 }
 
 /// Checks the options before anything renders.
@@ -123,81 +177,173 @@ fn render(
     Ok((hdr, out.report))
 }
 
-/// Runs the sweep; `progress` sees each point as it completes.
-pub fn run(
-    ctx: &Arc<Context>,
-    opts: &SweepOptions,
-    mut progress: impl FnMut(&Point),
-) -> Result<Sweep> {
-    validate(opts)?;
-    let mut file = opts.scene.clone();
-    file.render.skybox = false;
-    let mut scene = Scene::load(file)?;
-    let reference = Variant {
-        resolution: opts.reference_resolution,
-        kernel: Kernel::Accurate,
-        chain: Chain::Full,
-    };
-    let (ref_final, _) = render(ctx, &mut scene, reference, View::Final, 1)?;
-    let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::Diffuse, 1)?;
-    let mask = coverage_mask(&ref_final);
-    let mut points = Vec::new();
-    for &resolution in &opts.resolutions {
-        for &kernel in &opts.kernels {
-            for &chain in &opts.chains {
-                let variant = Variant {
-                    resolution,
-                    kernel,
-                    chain,
-                };
-                let (image, report) = render(ctx, &mut scene, variant, View::Final, opts.frames)?;
-                let (diffuse, _) = render(ctx, &mut scene, variant, View::Diffuse, 1)?;
-                let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
-                let is_ruler = |p: &PassStats| p.name.starts_with("ruler_");
-                let is_chain =
-                    |p: &PassStats| p.name.starts_with("blur") || p.name.starts_with("stretch");
-                let point = Point {
-                    variant,
-                    total_ms: report
-                        .passes
-                        .iter()
-                        .filter(|p| !is_ruler(p))
-                        .map(median)
-                        .sum(),
-                    chain_ms: report
-                        .passes
-                        .iter()
-                        .filter(|p| is_chain(p))
-                        .map(median)
-                        .sum(),
-                    frame_span: report.frame_span.clone(),
-                    transient_bytes: report.memory.transient_pool_bytes,
-                    final_error: compare(&ref_final, &image, &mask)?,
-                    diffuse_error: compare(&ref_diffuse, &diffuse, &mask)?,
-                    passes: report.passes,
-                };
-                progress(&point);
-                points.push(point);
-            }
-        }
+/// FNV-1a 64 over the reference's final then diffuse image, as f32 bytes in
+/// memory order (little-endian on every platform dermis runs on).
+pub fn reference_checksum(final_image: &[f32], diffuse: &[f32]) -> String {
+    hash::hex(hash::fnv1a64_parts([
+        bytemuck::cast_slice::<f32, u8>(final_image),
+        bytemuck::cast_slice::<f32, u8>(diffuse),
+    ]))
+}
+
+/// The scene loaded once, the reference rendered: renders points against it.
+pub struct Session<'a> {
+    ctx: &'a Arc<Context>,
+    opts: &'a SweepOptions,
+    scene: Scene,
+    ref_final: Vec<f32>,
+    ref_diffuse: Vec<f32>,
+    mask: Vec<bool>,
+    pub reference: Variant,
+    pub reference_checksum: String,
+    /// The reference render's clock ("gpu-timestamp", "host-fence").
+    pub clock: String,
+}
+
+impl<'a> Session<'a> {
+    /// Loads the scene (skybox off) and renders the reference. Rendering is
+    /// deterministic on one device and driver, so every shard renders its own.
+    pub fn new(ctx: &'a Arc<Context>, opts: &'a SweepOptions) -> Result<Self> {
+        validate(opts)?;
+        let mut file = opts.scene.clone();
+        file.render.skybox = false;
+        let mut scene = Scene::load(file)?;
+        let reference = points::reference(opts);
+        let (ref_final, report) = render(ctx, &mut scene, reference, View::Final, 1)?;
+        let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::Diffuse, 1)?;
+        Ok(Self {
+            ctx,
+            opts,
+            mask: coverage_mask(&ref_final),
+            reference_checksum: reference_checksum(&ref_final, &ref_diffuse),
+            ref_final,
+            ref_diffuse,
+            scene,
+            reference,
+            clock: report.fingerprint.clock,
+        })
     }
-    Ok(Sweep {
+
+    /// Renders and measures one point.
+    pub fn point(&mut self, variant: Variant) -> Result<Point> {
+        let (ctx, frames) = (self.ctx, self.opts.frames);
+        let (image, report) = render(ctx, &mut self.scene, variant, View::Final, frames)?;
+        let (diffuse, _) = render(ctx, &mut self.scene, variant, View::Diffuse, 1)?;
+        let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
+        let is_ruler = |p: &PassStats| p.name.starts_with("ruler_");
+        let is_chain = |p: &PassStats| p.name.starts_with("blur") || p.name.starts_with("stretch");
+        Ok(Point {
+            id: variant.id(),
+            variant,
+            total_ms: report
+                .passes
+                .iter()
+                .filter(|p| !is_ruler(p))
+                .map(median)
+                .sum(),
+            chain_ms: report
+                .passes
+                .iter()
+                .filter(|p| is_chain(p))
+                .map(median)
+                .sum(),
+            frame_span: report.frame_span.clone(),
+            transient_bytes: report.memory.transient_pool_bytes,
+            final_error: compare(&self.ref_final, &image, &self.mask)?,
+            diffuse_error: compare(&self.ref_diffuse, &diffuse, &self.mask)?,
+            passes: report.passes,
+        })
+    }
+}
+
+/// How one process runs its part of the sweep.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// `None`: every point.
+    pub shard: Option<Shard>,
+    /// The JSON Lines log: a header, then each point as it completes.
+    pub log: Option<PathBuf>,
+    /// Skip the points the log already holds for this sweep hash (and append).
+    pub resume: bool,
+}
+
+/// A sweep's description without points, for this process (fresh run id,
+/// timestamp and fingerprint).
+pub fn describe(ctx: &Context, opts: &SweepOptions, session: &Session) -> Sweep {
+    let mut fingerprint = Fingerprint::of(&ctx.info);
+    fingerprint.clock = session.clock.clone();
+    Sweep {
+        schema_version: SWEEP_SCHEMA_VERSION,
+        sweep_hash: points::sweep_hash(opts),
+        run_id: run_id(),
+        timestamp: timestamp(),
         dermis_version: VERSION.into(),
         git_commit: GIT_COMMIT.into(),
-        device: ctx.info.name.clone(),
-        driver: format!("{} {}", ctx.info.driver_name, ctx.info.driver_info)
-            .trim()
-            .into(),
+        device: fingerprint.device.clone(),
+        driver: fingerprint.driver.clone(),
+        fingerprint,
         scene: opts.scene_label.clone(),
+        environment: opts.scene.environment.source.to_string(),
         width: opts.scene.render.width,
         height: opts.scene.render.height,
         frames: opts.frames,
-        reference,
-        points,
-    })
+        reference: session.reference,
+        reference_checksum: session.reference_checksum.clone(),
+        points: Vec::new(),
+        shards: Vec::new(),
+    }
 }
 
-fn name<T: Serialize>(v: &T) -> String {
+/// Runs the sweep, or this process's shard of it; `progress` sees each point as
+/// it completes. The sweep returned holds this run's points (and, resuming,
+/// those the log held), in canonical order.
+pub fn run(
+    ctx: &Arc<Context>,
+    opts: &SweepOptions,
+    how: &RunOptions,
+    mut progress: impl FnMut(&Point),
+) -> Result<Sweep> {
+    validate(opts)?;
+    let all = points::variants(opts);
+    let ids: Vec<String> = all.iter().map(Variant::id).collect();
+    let mine: Vec<Variant> = all
+        .iter()
+        .enumerate()
+        .filter(|(i, v)| how.shard.is_none_or(|s| s.takes(*i, &v.id())))
+        .map(|(_, v)| *v)
+        .collect();
+    let hash = points::sweep_hash(opts);
+    let mut done: Vec<Point> = match (&how.log, how.resume) {
+        (Some(path), true) => log::completed(path, &hash)?,
+        _ => Vec::new(),
+    };
+    done.retain(|p| mine.iter().any(|v| v.id() == p.id));
+    let mut session = Session::new(ctx, opts)?;
+    let mut sweep = describe(ctx, opts, &session);
+    let mut writer = match &how.log {
+        Some(path) => {
+            let header = log::Header::new(&sweep, how.shard, &ids, &mine);
+            Some(log::Writer::create(path, &header, how.resume)?)
+        }
+        None => None,
+    };
+    for v in mine {
+        if done.iter().any(|p| p.id == v.id()) {
+            continue;
+        }
+        let point = session.point(v)?;
+        if let Some(w) = &mut writer {
+            w.append(&point)?;
+        }
+        progress(&point);
+        done.push(point);
+    }
+    done.sort_by_key(|p| ids.iter().position(|id| *id == p.id));
+    sweep.points = done;
+    Ok(sweep)
+}
+
+pub(crate) fn name<T: Serialize>(v: &T) -> String {
     serde_json::to_value(v)
         .ok()
         .and_then(|v| v.as_str().map(str::to_string))
@@ -206,11 +352,24 @@ fn name<T: Serialize>(v: &T) -> String {
 
 pub const CSV_HEADER: &str = "resolution,kernel,chain,pass,median_ms,min_ms,max_ms,p90_ms,\
 texels,ns_per_texel,gb_per_s,x_ruler,transient_bytes,final_rmse_rel,final_max_rel,\
-final_p99_rel,final_psnr_db,diffuse_rmse_rel,diffuse_max_rel,diffuse_p99_rel,diffuse_psnr_db";
+final_p99_rel,final_psnr_db,diffuse_rmse_rel,diffuse_max_rel,diffuse_p99_rel,diffuse_psnr_db,\
+point_id,run_id,sweep_hash,scene,environment,device,git_commit";
 
 /// One row per point and pass, then a `total` row per point (ruler excluded).
+/// Every row ends with the point id and the run's identity (run id, sweep
+/// hash, scene, environment, device, commit), so concatenated files stay apart.
 pub fn csv(sweep: &Sweep) -> String {
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+    let run = [
+        &sweep.run_id,
+        &sweep.sweep_hash,
+        &sweep.scene,
+        &sweep.environment,
+        &sweep.device,
+        &sweep.git_commit,
+    ]
+    .map(|s| field(s))
+    .join(",");
     let mut out = format!("{CSV_HEADER}\n");
     for p in &sweep.points {
         let v = p.variant;
@@ -228,12 +387,13 @@ pub fn csv(sweep: &Sweep) -> String {
             .collect::<Vec<_>>()
             .join(",");
         let prefix = format!("{},{},{}", v.resolution, name(&v.kernel), name(&v.chain));
+        let id = field(&p.id);
         let ms = |ns: Option<f64>| opt(ns.map(|v| v / 1e6));
         for s in &p.passes {
             let t = s.time;
             out += &format!(
-                "{prefix},{},{},{},{},{},{},{},{},{},{},{errors}\n",
-                s.name,
+                "{prefix},{},{},{},{},{},{},{},{},{},{},{errors},{id},{run}\n",
+                field(&s.name),
                 ms(t.map(|t| t.median_ns)),
                 ms(t.map(|t| t.min_ns)),
                 ms(t.map(|t| t.max_ns)),
@@ -246,7 +406,7 @@ pub fn csv(sweep: &Sweep) -> String {
             );
         }
         out += &format!(
-            "{prefix},total,{},,,,,,,,{},{errors}\n",
+            "{prefix},total,{},,,,,,,,{},{errors},{id},{run}\n",
             p.total_ms, p.transient_bytes
         );
     }
@@ -259,7 +419,34 @@ pub fn load(path: &std::path::Path) -> Result<Sweep> {
         path: path.display().to_string(),
         source,
     })?;
-    serde_json::from_str(&text).map_err(|e| Error::Input(format!("{}: {e}", path.display())))
+    let mut sweep: Sweep = serde_json::from_str(&text)
+        .map_err(|e| Error::Input(format!("{}: {e}", path.display())))?;
+    // Sweeps written before ids.
+    for p in sweep.points.iter_mut().filter(|p| p.id.is_empty()) {
+        p.id = p.variant.id();
+    }
+    Ok(sweep)
+}
+
+/// The table `dermis sweep` prints as points complete: its header…
+pub const TABLE_HEADER: &str = "   res kernel    chain       frame ms   chain ms  ruler ns   \
+final % diffuse %   pool MiB";
+
+/// …and a point's row.
+pub fn table_row(p: &Point) -> String {
+    let v = p.variant;
+    format!(
+        "{:>6} {:<9} {:<9} {:>10.2} {:>10.2} {:>9.2} {:>9.3} {:>9.3} {:>10.1}",
+        v.resolution,
+        name(&v.kernel),
+        name(&v.chain),
+        p.total_ms,
+        p.chain_ms,
+        ruler_ns_per_texel(p).unwrap_or(f64::NAN),
+        100.0 * p.final_error.rmse_rel,
+        100.0 * p.diffuse_error.rmse_rel,
+        p.transient_bytes as f64 / (1u64 << 20) as f64
+    )
 }
 
 /// The ruler's ns/texel of a point (for tables).
