@@ -10,6 +10,7 @@ use dermis::scene::file::{
     default_scene_path, scene_by_name, Chain, Kernel, LightsMode, Occlusion, ToneCurve, UvOrigin,
 };
 use dermis::scene::{Overrides, Scene};
+use dermis::sweep::compare as compare_input;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -393,7 +394,8 @@ struct DecideArgs {
     /// where they scatter less between samples than ms).
     #[arg(long, value_enum, default_value = "auto")]
     unit: compare::Unit,
-    /// Relative change below which a pass is not reported changed (0.03 = 3 %).
+    /// Relative change below which a pass is not reported changed (0.05 = 5 %:
+    /// the A/A noise measured in docs/performance.md).
     #[arg(long, default_value_t = compare::DEFAULT_NOISE_THRESHOLD)]
     noise_threshold: f64,
     /// Family-wise significance level (Holm-corrected over the passes).
@@ -910,30 +912,32 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
             })?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Compare { base, new, decide } => match (load_side(&base)?, load_side(&new)?) {
-            (Side::Runs(base, w1), Side::Runs(new, w2)) => {
-                report_comparison(&[(String::new(), base, new)], &decide, [w1, w2].concat())
-            }
-            (Side::Sweep(base), Side::Sweep(mut new)) => {
-                let mut warnings = Vec::new();
-                let mut pairs = Vec::new();
-                for (id, b) in base {
-                    match new.iter().position(|(n, _)| *n == id) {
-                        Some(i) => pairs.push((id, b, new.remove(i).1)),
-                        None => warnings.push(format!("point {id} is only in the base")),
-                    }
+        Command::Compare { base, new, decide } => {
+            match (compare_input::load(&base)?, compare_input::load(&new)?) {
+                (compare_input::Side::Runs(base, w1), compare_input::Side::Runs(new, w2)) => {
+                    report_comparison(&[(String::new(), *base, *new)], &decide, [w1, w2].concat())
                 }
-                warnings.extend(
-                    new.iter()
-                        .map(|(id, _)| format!("point {id} is only in the new sweep")),
-                );
-                report_comparison(&pairs, &decide, warnings)
+                (compare_input::Side::Sweep(base), compare_input::Side::Sweep(mut new)) => {
+                    let mut warnings = Vec::new();
+                    let mut pairs = Vec::new();
+                    for (id, b) in base {
+                        match new.iter().position(|(n, _)| *n == id) {
+                            Some(i) => pairs.push((id, b, new.remove(i).1)),
+                            None => warnings.push(format!("point {id} is only in the base")),
+                        }
+                    }
+                    warnings.extend(
+                        new.iter()
+                            .map(|(id, _)| format!("point {id} is only in the new sweep")),
+                    );
+                    report_comparison(&pairs, &decide, warnings)
+                }
+                _ => Err(dermis::Error::Input(
+                    "compare: give two reports (or folders of them) or two sweeps, not one of each"
+                        .into(),
+                )),
             }
-            _ => Err(dermis::Error::Input(
-                "compare: give two reports (or folders of them) or two sweeps, not one of each"
-                    .into(),
-            )),
-        },
+        }
         Command::Interleave {
             runs,
             frames,
@@ -1132,54 +1136,6 @@ fn read_text(path: &Path) -> dermis::Result<String> {
         path: path.display().to_string(),
         source,
     })
-}
-
-/// One side of `compare`.
-enum Side {
-    /// A report, or a folder of reports pooled as runs; warnings of pooling.
-    Runs(Measurement, Vec<String>),
-    /// A sweep's points by id.
-    Sweep(Vec<(String, Measurement)>),
-}
-
-fn load_side(path: &Path) -> dermis::Result<Side> {
-    let files = if path.is_dir() {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(path)
-            .map_err(|source| dermis::Error::Io {
-                path: path.display().to_string(),
-                source,
-            })?
-            .filter_map(|e| Some(e.ok()?.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "json"))
-            .collect();
-        files.sort();
-        if files.is_empty() {
-            return Err(dermis::Error::Input(format!(
-                "{}: no .json reports in this folder",
-                path.display()
-            )));
-        }
-        files
-    } else {
-        vec![path.to_path_buf()]
-    };
-    let text = read_text(&files[0])?;
-    if files.len() == 1 && text.contains("\"points\"") && !text.contains("\"per_frame\"") {
-        let sweep = dermis::sweep::load(&files[0])?;
-        let source = files[0].display().to_string();
-        return Ok(Side::Sweep(dermis::sweep::compare::measurements(
-            &sweep, &source,
-        )?));
-    }
-    let parts = files
-        .iter()
-        .map(|f| Measurement::from_report_json(&read_text(f)?, &f.display().to_string()))
-        .collect::<dermis::Result<Vec<_>>>()?;
-    let (mut m, warnings) = Measurement::pool(parts)?;
-    if files.len() > 1 {
-        m.source = format!("{} ({} reports)", path.display(), files.len());
-    }
-    Ok(Side::Runs(m, warnings))
 }
 
 /// Compares each pair (a sweep's points by id; a report's one pair with no

@@ -18,7 +18,8 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "graph"],
     &["profile"],
     &["gpu"],
-    &["error", "assets", "atomic", "text"],
+    &["atomic"],
+    &["error", "assets", "text"],
 ];
 
 fn layer_of(module: &str) -> usize {

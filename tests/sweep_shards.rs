@@ -270,7 +270,8 @@ fn three_shards_merge_into_the_unsharded_sweep() {
         ],
         &[],
     );
-    let c: Value = serde_json::from_str(&check("compare", &out)).unwrap();
+    check("compare", &out);
+    let c: Value = serde_json::from_slice(&out.stdout).unwrap();
     let compared: Vec<&str> = c["points"]
         .as_array()
         .unwrap()

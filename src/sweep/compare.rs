@@ -1,10 +1,67 @@
-//! A sweep's points as `dermis compare` measurements: each point one run of
-//! its measured frames (the samples its passes kept), keyed by point id.
+//! What `dermis compare` reads: a run report, a folder of them (pooled as
+//! runs), or a sweep, whose points are measurements of one run of their
+//! measured frames (the samples their passes kept), keyed by point id.
 
 use super::{Point, Sweep};
 use crate::error::{Error, Result};
 use crate::profile::compare::{MeasuredFrame, Measurement};
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One side of `dermis compare`.
+pub enum Side {
+    /// A report, or a folder of reports pooled as runs; warnings of pooling.
+    Runs(Box<Measurement>, Vec<String>),
+    /// A sweep's points by id.
+    Sweep(Vec<(String, Measurement)>),
+}
+
+pub fn load(path: &Path) -> Result<Side> {
+    let files = if path.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+            .map_err(|source| Error::Io {
+                path: path.display().to_string(),
+                source,
+            })?
+            .filter_map(|e| Some(e.ok()?.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            return Err(Error::Input(format!(
+                "{}: no .json reports in this folder",
+                path.display()
+            )));
+        }
+        files
+    } else {
+        vec![path.to_path_buf()]
+    };
+    let text = std::fs::read_to_string(&files[0]).map_err(|source| Error::Io {
+        path: files[0].display().to_string(),
+        source,
+    })?;
+    if files.len() == 1 && text.contains("\"points\"") && !text.contains("\"per_frame\"") {
+        let sweep = super::load(&files[0])?;
+        let source = files[0].display().to_string();
+        return Ok(Side::Sweep(measurements(&sweep, &source)?));
+    }
+    let parts = files
+        .iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(f).map_err(|source| Error::Io {
+                path: f.display().to_string(),
+                source,
+            })?;
+            Measurement::from_report_json(&text, &f.display().to_string())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (mut m, warnings) = Measurement::pool(parts)?;
+    if files.len() > 1 {
+        m.source = format!("{} ({} reports)", path.display(), files.len());
+    }
+    Ok(Side::Runs(Box::new(m), warnings))
+}
 
 /// Every point of `sweep` with its samples; `source` names the file.
 pub fn measurements(sweep: &Sweep, source: &str) -> Result<Vec<(String, Measurement)>> {

@@ -11,7 +11,7 @@ pub fn json(sweep: &Sweep) -> Result<String> {
 
 /// `sweep.csv` and the plots (what `--replot` redraws).
 pub fn write_csv_and_plots(sweep: &Sweep, dir: &Path) -> Result<()> {
-    write_atomic(&dir.join("sweep.csv"), &csv(sweep))?;
+    write_atomic(&dir.join("sweep.csv"), csv(sweep))?;
     plot::write_plots(sweep, dir)
 }
 
