@@ -956,7 +956,7 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
                 ("base", base_bin.unwrap_or_else(|| me.clone()), base_args),
                 ("new", new_bin.unwrap_or(me), new_args),
             ];
-            let [base, new] = interleave(&sides, runs, frames, &out_dir)?;
+            let [base, new] = dermis::sweep::interleave::run(&sides, runs, frames, &out_dir)?;
             report_comparison(
                 &[(String::new(), base.0, new.0)],
                 &decide,
@@ -1202,99 +1202,4 @@ fn report_comparison(
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// Options `interleave` sets itself on each run.
-const INTERLEAVE_OWNS: [&str; 5] = ["--report", "--out", "--frames", "--runs", "--ruler"];
-
-/// Runs each side `runs` times as separate processes, alternating A B B A …,
-/// and reads their reports back, pooled per side.
-fn interleave(
-    sides: &[(&str, PathBuf, String); 2],
-    runs: u32,
-    frames: u32,
-    out_dir: &Path,
-) -> dermis::Result<[(Measurement, Vec<String>); 2]> {
-    if runs < 2 || frames < 2 {
-        return Err(dermis::Error::Input(format!(
-            "interleave: --runs {runs} --frames {frames}: give at least 2 of each \
-             (runs are the samples; each run's first frame is warm-up)"
-        )));
-    }
-    let mut args = Vec::new();
-    for (name, bin, text) in sides {
-        let a = shlex::split(text).ok_or_else(|| {
-            dermis::Error::Input(format!("--{name}-args {text:?}: unbalanced quotes"))
-        })?;
-        if let Some(owned) = a.iter().find(|x| {
-            INTERLEAVE_OWNS
-                .iter()
-                .any(|o| x.split('=').next() == Some(o))
-        }) {
-            return Err(dermis::Error::Input(format!(
-                "--{name}-args: {owned} is set by interleave itself ({})",
-                INTERLEAVE_OWNS.join(", ")
-            )));
-        }
-        if !bin.is_file() {
-            return Err(dermis::Error::Input(format!(
-                "--{name}-bin {}: no such file",
-                bin.display()
-            )));
-        }
-        args.push(a);
-    }
-    for (name, _, _) in sides {
-        let dir = out_dir.join(name);
-        std::fs::create_dir_all(&dir).map_err(|source| dermis::Error::Io {
-            path: dir.display().to_string(),
-            source,
-        })?;
-    }
-    let mut files: [Vec<PathBuf>; 2] = [Vec::new(), Vec::new()];
-    for k in 0..runs {
-        // A B, then B A: a linear drift falls on both sides alike.
-        let order = if k % 2 == 0 { [0, 1] } else { [1, 0] };
-        for i in order {
-            let (name, bin, _) = &sides[i];
-            let report = out_dir.join(name).join(format!("run-{k:03}.json"));
-            let started = std::time::Instant::now();
-            let status = std::process::Command::new(bin)
-                .arg("render")
-                .args(&args[i])
-                .args(["--frames", &frames.to_string(), "--ruler", "--report"])
-                .arg(&report)
-                .arg("--out")
-                .arg(out_dir.join(format!("{name}.png")))
-                .stdout(std::process::Stdio::null())
-                .status()
-                .map_err(|source| dermis::Error::Io {
-                    path: bin.display().to_string(),
-                    source,
-                })?;
-            if !status.success() {
-                return Err(dermis::Error::Input(format!(
-                    "interleave: {name} run {} of {runs} ({} render …) failed: {status}",
-                    k + 1,
-                    bin.display()
-                )));
-            }
-            eprintln!(
-                "{name} {}/{runs}: {:.1} s",
-                k + 1,
-                started.elapsed().as_secs_f64()
-            );
-            files[i].push(report);
-        }
-    }
-    let pool = |f: &[PathBuf]| -> dermis::Result<(Measurement, Vec<String>)> {
-        let parts = f
-            .iter()
-            .map(|p| Measurement::from_report_json(&read_text(p)?, &p.display().to_string()))
-            .collect::<dermis::Result<Vec<_>>>()?;
-        let (mut m, w) = Measurement::pool(parts)?;
-        m.source = format!("{} × {}", f.len(), f[0].display());
-        Ok((m, w))
-    };
-    Ok([pool(&files[0])?, pool(&files[1])?])
 }

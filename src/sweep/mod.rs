@@ -5,6 +5,7 @@
 
 pub mod compare;
 pub mod hash;
+pub mod interleave;
 pub mod lighting;
 pub mod log;
 pub mod merge;
