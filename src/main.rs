@@ -394,7 +394,7 @@ struct DecideArgs {
     /// where they scatter less between samples than ms).
     #[arg(long, value_enum, default_value = "auto")]
     unit: compare::Unit,
-    /// Relative change below which a pass is not reported changed (0.05 = 5 %:
+    /// Relative change below which a pass is not reported changed (0.06 = 6 %:
     /// the A/A noise measured in docs/performance.md).
     #[arg(long, default_value_t = compare::DEFAULT_NOISE_THRESHOLD)]
     noise_threshold: f64,
