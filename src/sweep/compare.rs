@@ -46,6 +46,15 @@ pub fn load(path: &Path) -> Result<Side> {
         let source = files[0].display().to_string();
         return Ok(Side::Sweep(measurements(&sweep, &source)?));
     }
+    let (mut m, warnings) = pool(&files)?;
+    if files.len() > 1 {
+        m.source = format!("{} ({} reports)", path.display(), files.len());
+    }
+    Ok(Side::Runs(Box::new(m), warnings))
+}
+
+/// Run reports read and pooled as runs of one setup, with pooling's warnings.
+pub fn pool(files: &[PathBuf]) -> Result<(Measurement, Vec<String>)> {
     let parts = files
         .iter()
         .map(|f| {
@@ -56,11 +65,7 @@ pub fn load(path: &Path) -> Result<Side> {
             Measurement::from_report_json(&text, &f.display().to_string())
         })
         .collect::<Result<Vec<_>>>()?;
-    let (mut m, warnings) = Measurement::pool(parts)?;
-    if files.len() > 1 {
-        m.source = format!("{} ({} reports)", path.display(), files.len());
-    }
-    Ok(Side::Runs(Box::new(m), warnings))
+    Measurement::pool(parts)
 }
 
 /// Every point of `sweep` with its samples; `source` names the file.

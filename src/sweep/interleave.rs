@@ -89,17 +89,7 @@ pub fn run(
         }
     }
     let pool = |f: &[PathBuf]| -> Result<(Measurement, Vec<String>)> {
-        let parts = f
-            .iter()
-            .map(|p| {
-                let text = std::fs::read_to_string(p).map_err(|source| Error::Io {
-                    path: p.display().to_string(),
-                    source,
-                })?;
-                Measurement::from_report_json(&text, &p.display().to_string())
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let (mut m, w) = Measurement::pool(parts)?;
+        let (mut m, w) = super::compare::pool(f)?;
         m.source = format!("{} × {}", f.len(), f[0].display());
         Ok((m, w))
     };
