@@ -1,6 +1,8 @@
 //! The command line as users run it, with validation on: outputs, reports, and
 //! clean failures (exit status 2, one line naming the problem) for bad input.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -70,25 +72,6 @@ fn render_writes_png_report_and_graph() {
     assert!(report["fingerprint"]["device"]
         .as_str()
         .is_some_and(|d| !d.is_empty()));
-}
-
-/// Splits a CSV line, honouring quoted fields (with "" for a quote).
-fn csv_fields(line: &str) -> Vec<String> {
-    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' if quoted && chars.peek() == Some(&'"') => {
-                cur.push('"');
-                chars.next();
-            }
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
-            c => cur.push(c),
-        }
-    }
-    fields.push(cur);
-    fields
 }
 
 #[test]
@@ -227,7 +210,7 @@ fn render_writes_self_describing_report_trace_and_csv() {
     // The CSV: a header, then one row per pass per frame, every row complete.
     let text = read(&csv);
     let lines: Vec<&str> = text.lines().collect();
-    let header = csv_fields(lines[0]);
+    let header = common::csv_fields(lines[0]);
     for column in [
         "frame",
         "pass",
@@ -257,7 +240,7 @@ fn render_writes_self_describing_report_trace_and_csv() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let mut rows_per_frame = [0usize; 3];
     for line in &lines[1..] {
-        let row = csv_fields(line);
+        let row = common::csv_fields(line);
         assert_eq!(row.len(), header.len(), "{line}");
         assert_eq!(row[col("irradiance_resolution")], "256");
         assert_eq!(row[col("view")], "final");

@@ -18,26 +18,6 @@ fn dermis(args: &[&str]) -> Output {
         .expect("dermis runs")
 }
 
-/// Splits a CSV line, honouring quoted fields (the device and environment
-/// columns hold commas).
-fn csv_fields(line: &str) -> Vec<String> {
-    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' if quoted && chars.peek() == Some(&'"') => {
-                cur.push('"');
-                chars.next();
-            }
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
-            c => cur.push(c),
-        }
-    }
-    fields.push(cur);
-    fields
-}
-
 #[test]
 fn sweep_writes_csv_json_and_plots_naming_every_pass() {
     let dir = std::env::temp_dir().join(format!("dermis-sweep-{}", std::process::id()));
@@ -74,8 +54,8 @@ fn sweep_writes_csv_json_and_plots_naming_every_pass() {
     assert_eq!(json["reference"]["kernel"], "accurate");
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let mut lines = csv.lines();
-    let header: Vec<String> = csv_fields(lines.next().unwrap());
-    let rows: Vec<Vec<String>> = lines.map(csv_fields).collect();
+    let header: Vec<String> = common::csv_fields(lines.next().unwrap());
+    let rows: Vec<Vec<String>> = lines.map(common::csv_fields).collect();
     assert!(rows.iter().all(|r| r.len() == header.len()), "ragged CSV");
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     for p in points {

@@ -12,7 +12,7 @@ use super::bootstrap::relative_change_ci;
 use super::fingerprint::Fingerprint;
 use super::run::{RunReport, RULER_COPY, SCHEMA_VERSION};
 use super::significance::{holm, mann_whitney_p, smallest_p};
-use super::stats::median;
+use super::stats::{median, Stats};
 use crate::error::{Error, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -235,13 +235,8 @@ pub enum Unit {
 
 /// Coefficient of variation (sample standard deviation over the mean).
 fn scatter(v: &[f64]) -> Option<f64> {
-    let n = v.len();
-    if n < 2 {
-        return None;
-    }
-    let mean = v.iter().sum::<f64>() / n as f64;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-    (mean > 0.0).then(|| var.sqrt() / mean)
+    let s = Stats::of(v).filter(|_| v.len() >= 2)?;
+    (s.mean_ns > 0.0).then(|| s.std_ns / s.mean_ns)
 }
 
 /// How to decide.

@@ -12,26 +12,11 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// `git rev-parse --short HEAD` at build time (build.rs), or "unknown".
 pub const GIT_COMMIT: &str = env!("DERMIS_GIT_COMMIT");
 /// Whether the built sources differed from that commit (build.rs).
-pub const GIT_DIRTY: bool = const_str_eq(env!("DERMIS_GIT_DIRTY"), "true");
+pub const GIT_DIRTY: bool = matches!(env!("DERMIS_GIT_DIRTY").as_bytes(), b"true");
 
 /// The version of the report's JSON layout (`docs/report.schema.json`): 2 added
 /// the fingerprint, runs, samples, mean and standard deviation.
 pub const SCHEMA_VERSION: u32 = 2;
-
-const fn const_str_eq(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
 
 /// The camera as rendered, in millimetres.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]

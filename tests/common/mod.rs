@@ -71,3 +71,23 @@ pub fn from_f16_bytes(bytes: &[u8]) -> Vec<f32> {
 pub fn round_f16(v: f32) -> f32 {
     half::f16::from_f32(v).to_f32()
 }
+
+/// Splits a CSV line, honouring quoted fields (the device and environment
+/// columns hold commas).
+pub fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+            c => cur.push(c),
+        }
+    }
+    fields.push(cur);
+    fields
+}
