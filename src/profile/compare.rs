@@ -346,6 +346,51 @@ impl Comparison {
 
 /// Compares `new` with `base`.
 pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> Result<Comparison> {
+    check_options(opts)?;
+    let (mut warnings, setup_changes) = check_comparable(base, new, opts)?;
+    let by_run = base.runs() >= 2 && new.runs() >= 2;
+    if !by_run {
+        warnings.push(format!(
+            "one run on a side ({} vs {}): frames of one process share its state; \
+             use render --runs or dermis interleave for repetitions",
+            base.runs(),
+            new.runs()
+        ));
+    }
+    let ruler = in_ruler_units(base, new, opts, by_run, &mut warnings)?;
+    let mut names: Vec<String> = base
+        .pass_order
+        .iter()
+        .filter(|n| new.pass_order.contains(n))
+        .cloned()
+        .collect();
+    names.push(FRAME_ROW.into());
+    let only_in_base = only(&base.pass_order, &new.pass_order);
+    let only_in_new = only(&new.pass_order, &base.pass_order);
+
+    let mut rows: Vec<PassChange> = names
+        .iter()
+        .map(|name| pass_change(base, new, name, ruler, by_run))
+        .collect();
+    holm_adjust(&mut rows);
+    let family = rows.iter().filter(|r| !r.ruler).count().max(1);
+    for r in &mut rows {
+        decide(r, opts, family);
+    }
+    Ok(Comparison {
+        base: base.source.clone(),
+        new: new.source.clone(),
+        options: *opts,
+        warnings,
+        setup_changes,
+        passes: rows,
+        only_in_base,
+        only_in_new,
+    })
+}
+
+/// The threshold and the level must be fractions.
+fn check_options(opts: &CompareOptions) -> Result<()> {
     if !(opts.noise_threshold >= 0.0 && opts.noise_threshold < 1.0) {
         return Err(Error::Input(format!(
             "--noise-threshold {}: give a fraction in [0, 1) (0.06 = 6 %)",
@@ -358,6 +403,17 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
             opts.significance
         )));
     }
+    Ok(())
+}
+
+/// Refuses sides without frames, timed by different clocks, or (unless
+/// allowed) rendering different work; returns the machine differences as
+/// warnings and the setup differences.
+fn check_comparable(
+    base: &Measurement,
+    new: &Measurement,
+    opts: &CompareOptions,
+) -> Result<(Vec<String>, Vec<String>)> {
     for m in [base, new] {
         if m.frames.is_empty() {
             return Err(Error::Input(format!(
@@ -373,7 +429,7 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
             base.source, fb.clock, new.source, fnew.clock
         )));
     }
-    let mut warnings: Vec<String> = fb
+    let warnings: Vec<String> = fb
         .differences(fnew)
         .into_iter()
         .map(|d| format!("different machine or settings: {d}"))
@@ -400,22 +456,25 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
                 .join(", ")
         )));
     }
-    let by_run = base.runs() >= 2 && new.runs() >= 2;
-    if !by_run {
-        warnings.push(format!(
-            "one run on a side ({} vs {}): frames of one process share its state; \
-             use render --runs or dermis interleave for repetitions",
-            base.runs(),
-            new.runs()
-        ));
-    }
+    Ok((warnings, setup_changes))
+}
+
+/// Whether passes are compared over the ruler (else in ms), per `opts.unit`;
+/// why not, where auto chose ms, goes to `warnings`.
+fn in_ruler_units(
+    base: &Measurement,
+    new: &Measurement,
+    opts: &CompareOptions,
+    by_run: bool,
+    warnings: &mut Vec<String>,
+) -> Result<bool> {
     let has_ruler = base.has_ruler() && new.has_ruler();
     let common: Vec<&String> = base
         .pass_order
         .iter()
         .filter(|n| new.pass_order.contains(n) && !n.starts_with("ruler_"))
         .collect();
-    let ruler = match opts.unit {
+    Ok(match opts.unit {
         Unit::Ms => false,
         Unit::Ruler if !has_ruler => {
             return Err(Error::Input(
@@ -452,64 +511,62 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
             }
             in_ruler < in_ms
         }
-    };
-    let mut names: Vec<String> = base
-        .pass_order
-        .iter()
-        .filter(|n| new.pass_order.contains(n))
-        .cloned()
-        .collect();
-    names.push(FRAME_ROW.into());
-    let only_in_base = only(&base.pass_order, &new.pass_order);
-    let only_in_new = only(&new.pass_order, &base.pass_order);
+    })
+}
 
-    let mut rows: Vec<PassChange> = names
-        .iter()
-        .map(|name| {
-            let is_ruler = name.starts_with("ruler_");
-            let in_ruler = ruler && !is_ruler;
-            let (b, n) = (
-                samples(base, name, in_ruler, by_run),
-                samples(new, name, in_ruler, by_run),
-            );
-            let (b_ms, n_ms) = (
-                samples(base, name, false, by_run),
-                samples(new, name, false, by_run),
-            );
-            let ci = relative_change_ci(&b, &n, CONFIDENCE);
-            let ms = |v: &[f64]| median(v).map(|x| x / 1e6);
-            // ns/texel over the ruler's: the per-frame ratio scaled by the texels.
-            let x_ruler = |m: &Measurement| {
-                let t = *m.texels.get(name)? as f64;
-                let r = *m.texels.get(RULER_COPY)? as f64;
-                let ratio = median(&samples(m, name, true, by_run)).filter(|_| ruler)?;
-                Some(ratio * r / t)
-            };
-            PassChange {
-                name: name.clone(),
-                unit: if in_ruler { "ruler" } else { "ms" },
-                sample: if by_run { "run" } else { "frame" },
-                base_samples: b.len(),
-                new_samples: n.len(),
-                base_ms: ms(&b_ms),
-                new_ms: ms(&n_ms),
-                base_x_ruler: x_ruler(base),
-                new_x_ruler: x_ruler(new),
-                change: ci.map(|c| c.0),
-                change_ms: median(&n_ms)
-                    .zip(median(&b_ms).filter(|&v| v > 0.0))
-                    .map(|(n, b)| n / b - 1.0),
-                ci_low: ci.map(|c| c.1),
-                ci_high: ci.map(|c| c.2),
-                p: mann_whitney_p(&b, &n),
-                p_holm: 1.0,
-                verdict: Verdict::Inconclusive,
-                ruler: is_ruler,
-                more_samples: None,
-            }
-        })
-        .collect();
-    // Holm over the judged rows; rulers are corrected on their own.
+/// One pass's row before Holm's correction and the verdict (`decide`).
+fn pass_change(
+    base: &Measurement,
+    new: &Measurement,
+    name: &str,
+    ruler: bool,
+    by_run: bool,
+) -> PassChange {
+    let is_ruler = name.starts_with("ruler_");
+    let in_ruler = ruler && !is_ruler;
+    let (b, n) = (
+        samples(base, name, in_ruler, by_run),
+        samples(new, name, in_ruler, by_run),
+    );
+    let (b_ms, n_ms) = (
+        samples(base, name, false, by_run),
+        samples(new, name, false, by_run),
+    );
+    let ci = relative_change_ci(&b, &n, CONFIDENCE);
+    let ms = |v: &[f64]| median(v).map(|x| x / 1e6);
+    // ns/texel over the ruler's: the per-frame ratio scaled by the texels.
+    let x_ruler = |m: &Measurement| {
+        let t = *m.texels.get(name)? as f64;
+        let r = *m.texels.get(RULER_COPY)? as f64;
+        let ratio = median(&samples(m, name, true, by_run)).filter(|_| ruler)?;
+        Some(ratio * r / t)
+    };
+    PassChange {
+        name: name.to_string(),
+        unit: if in_ruler { "ruler" } else { "ms" },
+        sample: if by_run { "run" } else { "frame" },
+        base_samples: b.len(),
+        new_samples: n.len(),
+        base_ms: ms(&b_ms),
+        new_ms: ms(&n_ms),
+        base_x_ruler: x_ruler(base),
+        new_x_ruler: x_ruler(new),
+        change: ci.map(|c| c.0),
+        change_ms: median(&n_ms)
+            .zip(median(&b_ms).filter(|&v| v > 0.0))
+            .map(|(n, b)| n / b - 1.0),
+        ci_low: ci.map(|c| c.1),
+        ci_high: ci.map(|c| c.2),
+        p: mann_whitney_p(&b, &n),
+        p_holm: 1.0,
+        verdict: Verdict::Inconclusive,
+        ruler: is_ruler,
+        more_samples: None,
+    }
+}
+
+/// Holm over the judged rows; rulers are corrected on their own.
+fn holm_adjust(rows: &mut [PassChange]) {
     for rulers in [false, true] {
         let idx: Vec<usize> = (0..rows.len())
             .filter(|&i| rows[i].ruler == rulers)
@@ -519,20 +576,6 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
             rows[i].p_holm = a;
         }
     }
-    let family = rows.iter().filter(|r| !r.ruler).count().max(1);
-    for r in &mut rows {
-        decide(r, opts, family);
-    }
-    Ok(Comparison {
-        base: base.source.clone(),
-        new: new.source.clone(),
-        options: *opts,
-        warnings,
-        setup_changes,
-        passes: rows,
-        only_in_base,
-        only_in_new,
-    })
 }
 
 fn only(a: &[String], b: &[String]) -> Vec<String> {
