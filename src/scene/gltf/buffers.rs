@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+/// Resolves every buffer: the GLB binary chunk, a `data:` URI, or a file relative
+/// to the glTF file. Errors name the missing or short buffer.
 pub(super) fn load_buffers(
     doc: &gltf::Document,
     blob: Option<&[u8]>,

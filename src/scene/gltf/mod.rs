@@ -206,11 +206,6 @@ fn build_mesh(bytes: &[u8], path: &Path, scale: f32) -> Result<Mesh, String> {
     Ok(out)
 }
 
-// ---------------------------------------------------------------------------
-// Buffers
-
-/// Resolves every buffer: the GLB binary chunk, a `data:` URI, or a file relative
-/// to the glTF file. Errors name the missing or short buffer.
 #[cfg(test)]
 mod tests {
     use super::buffers::{decode_base64, percent_decode};
@@ -276,21 +271,7 @@ mod tests {
             };
             let floats = |v: &[f32]| v.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
             let flat3: Vec<f32> = self.positions.iter().flatten().copied().collect();
-            // glTF 2.0 §3.7.2.1: POSITION accessors must carry min and max.
-            let (lo, hi) =
-                self.positions
-                    .iter()
-                    .fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
-                        (
-                            [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
-                            [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
-                        )
-                    });
-            let bound = |v: [f32; 3]| {
-                let v = v.map(|x| if x.is_finite() { x } else { 0.0 });
-                format!("[{},{},{}]", v[0], v[1], v[2])
-            };
-            let extra = format!(r#","min":{},"max":{}"#, bound(lo), bound(hi));
+            let extra = self.position_bounds();
             let a = add(
                 &mut bin,
                 floats(&flat3),
@@ -349,6 +330,25 @@ mod tests {
                 accessors.join(",")
             );
             (json, bin)
+        }
+
+        /// The POSITION accessor's `,"min":[..],"max":[..]` (glTF 2.0 §3.7.2.1:
+        /// POSITION accessors must carry min and max); non-finite bounds as 0.
+        fn position_bounds(&self) -> String {
+            let (lo, hi) =
+                self.positions
+                    .iter()
+                    .fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
+                        (
+                            [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
+                            [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
+                        )
+                    });
+            let bound = |v: [f32; 3]| {
+                let v = v.map(|x| if x.is_finite() { x } else { 0.0 });
+                format!("[{},{},{}]", v[0], v[1], v[2])
+            };
+            format!(r#","min":{},"max":{}"#, bound(lo), bound(hi))
         }
 
         /// Writes `<name>.gltf` + `<name>.bin` in `dir`.
