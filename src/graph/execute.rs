@@ -179,7 +179,7 @@ impl Executor {
 
     /// Plans a graph against the executor's transient pool. Submit the result
     /// next: the pool's state assumes it runs.
-    pub fn compile(&mut self, graph: Graph) -> Result<Compiled> {
+    pub fn compile(&mut self, mut graph: Graph) -> Result<Compiled> {
         let plan = graph.compile(&mut self.pool)?;
         Ok(Compiled { plan, graph })
     }
@@ -215,7 +215,12 @@ impl Executor {
             .map(|p| p.name.clone())
             .collect();
         let n = names.len();
-        let work: Vec<PassWork> = compiled.plan.passes.iter().map(|p| p.work).collect();
+        let work: Vec<PassWork> = compiled
+            .plan
+            .passes
+            .iter()
+            .map(|p| p.work.clone())
+            .collect();
         if self.clock == Clock::HostFence {
             let mut report = self.run_isolated(index, &compiled, &images, &buffers, names, sync)?;
             report.set_work(&work);

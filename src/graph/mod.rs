@@ -7,6 +7,7 @@
 //! reads `&` handles (kajiya-rg), so the code shows who mutates what.
 
 mod access;
+mod cull;
 mod execute;
 mod pass_cx;
 mod plan;
@@ -14,6 +15,7 @@ mod simple;
 pub mod upload;
 
 pub use access::{Access, AccessInfo};
+pub use cull::Kept;
 pub use execute::{Clock, Compiled, Executor, FrameSync};
 pub use pass_cx::{Descriptor, PassCx, ResolvedImage};
 pub use plan::{Barrier, Plan, PlannedPass, PlannedResource, PoolState};
@@ -74,6 +76,9 @@ pub(crate) struct ResourceDecl {
     pub name: String,
     pub kind: ResourceKind,
     pub import: Option<ImportDecl>,
+    /// Kept across frames (`Graph::import_kept_image`): the key of the inputs
+    /// its contents are to be computed from.
+    pub kept_key: Option<u64>,
 }
 
 pub(crate) struct ImportDecl {
@@ -100,6 +105,8 @@ pub(crate) struct PassDecl {
     pub uses: Vec<(usize, Access)>,
     pub attachments: Vec<Attachment>,
     pub record: Option<RecordFn>,
+    /// What the pass belongs to (e.g. the diffusion chain), for reports.
+    pub tags: Vec<&'static str>,
 }
 
 #[derive(Default)]
@@ -108,11 +115,79 @@ pub struct Graph {
     pub(crate) passes: Vec<PassDecl>,
     /// Declarations that contradict a shader's reflected layout; compiling fails.
     pub(crate) errors: Vec<String>,
+    /// Resources requested by the graph's owner (`Graph::output`).
+    pub(crate) outputs: Vec<usize>,
+    /// Other names of resources (`Graph::alias`).
+    pub(crate) aliases: Vec<(String, usize)>,
+    /// The keys the owner's kept resources were last computed for.
+    pub(crate) kept: Kept,
 }
 
 impl Graph {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A graph whose owner keeps resources across frames: `kept` says which
+    /// were computed, and for what (see [`Graph::import_kept_image`]).
+    pub fn with_kept(kept: Kept) -> Self {
+        Self {
+            kept,
+            ..Self::default()
+        }
+    }
+
+    /// Requests `image` as an output: the passes it depends on are kept when
+    /// the graph compiles (see [`Graph::compile`]).
+    pub fn output(&mut self, image: &ImageHandle) {
+        self.outputs.push(image.id);
+    }
+
+    /// Requests `buffer` as an output.
+    pub fn output_buffer(&mut self, buffer: &BufferHandle) {
+        self.outputs.push(buffer.id);
+    }
+
+    /// Gives `image` another name, by which [`Graph::find_image`] finds it
+    /// (e.g. a level that is its predecessor's image).
+    pub fn alias(&mut self, name: &str, image: &ImageHandle) {
+        self.aliases.push((name.into(), image.id));
+    }
+
+    /// The image named `name` (its own name or an alias; the last declared
+    /// of that name), readable by a pass added later.
+    pub fn find_image(&self, name: &str) -> Option<ImageHandle> {
+        let own = self
+            .resources
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (r.name.as_str(), i));
+        let aliases = self.aliases.iter().map(|(n, i)| (n.as_str(), *i));
+        let id = own
+            .chain(aliases)
+            .filter(|(n, _)| *n == name)
+            .map(|(_, i)| i)
+            .last()?;
+        match self.resources[id].kind {
+            ResourceKind::Image(desc) => Some(ImageHandle { id, desc }),
+            ResourceKind::Buffer(_) => None,
+        }
+    }
+
+    /// The names of the graph's images and their aliases, in declaration order.
+    pub fn image_names(&self) -> Vec<String> {
+        let own = self
+            .resources
+            .iter()
+            .filter(|r| matches!(r.kind, ResourceKind::Image(_)))
+            .map(|r| r.name.clone());
+        let mut names: Vec<String> = Vec::new();
+        for n in own.chain(self.aliases.iter().map(|(n, _)| n.clone())) {
+            if !names.contains(&n) {
+                names.push(n);
+            }
+        }
+        names
     }
 
     /// An image that lives only within the frame; backed by the executor's pool.
@@ -121,6 +196,7 @@ impl Graph {
             name: name.into(),
             kind: ResourceKind::Image(desc),
             import: None,
+            kept_key: None,
         });
         ImageHandle {
             id: self.resources.len() - 1,
@@ -148,6 +224,7 @@ impl Graph {
                 initial,
                 final_access,
             }),
+            kept_key: None,
         });
         ImageHandle {
             id: self.resources.len() - 1,
@@ -175,6 +252,7 @@ impl Graph {
                 initial,
                 final_access,
             }),
+            kept_key: None,
         });
         BufferHandle {
             id: self.resources.len() - 1,
@@ -191,6 +269,7 @@ impl Graph {
                 uses: Vec::new(),
                 attachments: Vec::new(),
                 record: None,
+                tags: Vec::new(),
             },
         }
     }
@@ -242,13 +321,18 @@ impl PassBuilder<'_> {
         self.write(image, Access::DepthAttachment)
     }
 
-    /// Finishes the pass with the closure that records its commands.
+    /// Tags the pass (e.g. as part of the diffusion chain): reports carry it.
+    pub fn tag(&mut self, tag: &'static str) {
+        self.pass.tags.push(tag);
+    }
+
     /// How many texels (invocations) the pass computes, for per-texel costs
     /// (a graphics pass defaults to its render area).
     pub fn texels(&mut self, texels: u64) {
         self.pass.texels = Some(texels);
     }
 
+    /// Finishes the pass with the closure that records its commands.
     pub fn record(mut self, f: impl Fn(&PassCx) + Send + 'static) {
         self.pass.record = Some(Box::new(f));
         self.graph.passes.push(self.pass);

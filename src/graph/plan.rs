@@ -25,7 +25,7 @@ pub struct PlannedPass {
     pub name: String,
     /// Issued as one `vkCmdPipelineBarrier2` before the pass.
     pub barriers: Vec<Barrier>,
-    /// What the pass is measured against (profile::PassWork).
+    /// What the pass is measured against, and its tags (profile::PassWork).
     pub work: PassWork,
 }
 
@@ -49,6 +49,8 @@ pub struct Plan {
     pub resources: Vec<PlannedResource>,
     /// Issued after the last pass (imports' final accesses).
     pub final_barriers: Vec<Barrier>,
+    /// What the owner keeps after the frame (graph::Kept).
+    pub kept: super::Kept,
 }
 
 /// Synchronisation state of one piece of memory (a pool slot or an import).
@@ -200,15 +202,21 @@ fn work(pass: &super::PassDecl, resources: &[PlannedResource]) -> PassWork {
             (None, None) => 0,
         };
     }
-    PassWork { texels, bytes }
+    PassWork {
+        texels,
+        bytes,
+        tags: pass.tags.clone(),
+    }
 }
 
 impl Graph {
-    /// Derives the plan. `pool` is updated only when compilation succeeds.
-    pub fn compile(&self, pool: &mut PoolState) -> Result<Plan> {
+    /// Drops the passes no output needs (`Graph::cull`), then derives the
+    /// plan. `pool` is updated only when compilation succeeds.
+    pub fn compile(&mut self, pool: &mut PoolState) -> Result<Plan> {
         if !self.errors.is_empty() {
             return Err(Error::Graph(self.errors.join("; ")));
         }
+        let kept = self.cull();
         let mut resources = self.plan_resources()?;
         let mut next_pool = pool.clone();
         assign_slots(&mut resources, &mut next_pool);
@@ -247,6 +255,10 @@ impl Graph {
             let Some(access) = decl.import.as_ref().and_then(|i| i.final_access) else {
                 continue;
             };
+            // An import no pass used is left as it was.
+            if resources[r].lifetime.is_none() {
+                continue;
+            }
             let is_image = resources[r].image.is_some();
             final_barriers.extend(tracks[r].transition(r, access, is_image, false));
         }
@@ -255,6 +267,7 @@ impl Graph {
             passes,
             resources,
             final_barriers,
+            kept,
         })
     }
 
@@ -304,7 +317,12 @@ impl Graph {
                         pass.name, res.name
                     )));
                 }
-                if res.lifetime.is_none() && !res.imported && !access.info().writes {
+                // Kept imports not yet computed hold nothing to read either.
+                let defined = self.resources[r]
+                    .import
+                    .as_ref()
+                    .is_some_and(|i| i.initial.is_some() || self.resources[r].kept_key.is_none());
+                if res.lifetime.is_none() && !defined && !access.info().writes {
                     return Err(Error::Graph(format!(
                         "pass {:?} reads {:?} before any pass writes it",
                         pass.name, res.name

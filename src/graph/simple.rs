@@ -179,6 +179,12 @@ impl<'g> SimplePass<'g> {
         self
     }
 
+    /// Tags the pass (`PassBuilder::tag`).
+    pub fn tag(mut self, tag: &'static str) -> Self {
+        self.pass.tag(tag);
+        self
+    }
+
     /// Dispatches enough workgroups (of the shader's reflected local size) to
     /// cover `threads` (x, y, z); 1-D and 2-D dispatches pass 1 for the rest.
     pub fn dispatch(mut self, threads: [u32; 3]) {

@@ -23,11 +23,13 @@ use serde::{Deserialize, Serialize};
 
 /// What a pass is measured against: the texels (invocations, or pixels of its
 /// render area) it computes and its nominal memory traffic, every graph image and
-/// buffer it reads or writes counted once at full size.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+/// buffer it reads or writes counted once at full size; and its tags (what it
+/// belongs to, e.g. the diffusion chain).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct PassWork {
     pub texels: Option<u64>,
     pub bytes: u64,
+    pub tags: Vec<&'static str>,
 }
 
 /// GPU time of one pass of one frame.
@@ -38,6 +40,9 @@ pub struct PassTime {
     pub texels: Option<u64>,
     /// Nominal traffic (see [`PassWork`]).
     pub bytes: Option<u64>,
+    /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tags: Vec<String>,
     /// `None` when the device has no timestamps or the delta was not positive.
     pub gpu_ns: Option<f64>,
     /// From the frame's start (first timestamp, or host start with host fences)
@@ -80,6 +85,7 @@ impl FrameReport {
         for (p, w) in self.passes.iter_mut().zip(work) {
             p.texels = w.texels;
             p.bytes = Some(w.bytes);
+            p.tags = w.tags.iter().map(|t| t.to_string()).collect();
         }
     }
 
@@ -157,6 +163,7 @@ impl FrameReport {
                 name: p.name.clone(),
                 texels: p.texels,
                 bytes: p.bytes,
+                tags: p.tags.clone(),
                 gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
                 start_ns: med(frames
                     .iter()

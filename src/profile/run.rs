@@ -122,6 +122,9 @@ pub struct PassStats {
     pub gb_per_s: Option<f64>,
     /// ns/texel as a multiple of the copy ruler's in the same run.
     pub x_ruler: Option<f64>,
+    /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tags: Vec<String>,
     /// The measured frames' times in frame order, `None` where a frame did not
     /// time it (`dermis compare` resamples these).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -140,9 +143,11 @@ impl PassStats {
         }
     }
 
-    /// Fills the per-texel figures from the pass's work and median.
-    fn with_work(mut self, texels: Option<u64>, bytes: Option<u64>) -> Self {
+    /// Fills the tags and per-texel figures from the pass's work and median.
+    fn with_work(mut self, work: Option<&PassTime>) -> Self {
         let median = self.time.map(|t| t.median_ns).filter(|&t| t > 0.0);
+        let (texels, bytes) = (work.and_then(|p| p.texels), work.and_then(|p| p.bytes));
+        self.tags = work.map(|p| p.tags.clone()).unwrap_or_default();
         self.texels = texels;
         self.bytes = bytes;
         self.ns_per_texel = median
@@ -230,8 +235,7 @@ impl RunReport {
             .map(|n| {
                 let v = measured.iter().map(|f| f.pass_ns(n)).collect();
                 let work = measured.iter().rev().find_map(|f| f.pass(n));
-                PassStats::of(n, v)
-                    .with_work(work.and_then(|p| p.texels), work.and_then(|p| p.bytes))
+                PassStats::of(n, v).with_work(work)
             })
             .collect();
         let ruler = passes
@@ -516,16 +520,27 @@ pub(super) mod tests {
         )
     }
 
+    /// A pass's work: `texels`, `bytes`, tagged `t`.
+    fn work(texels: Option<u64>, bytes: Option<u64>) -> PassTime {
+        PassTime {
+            texels,
+            bytes,
+            tags: vec!["t".into()],
+            ..PassTime::default()
+        }
+    }
+
     #[test]
     fn per_texel_figures_follow_from_work_and_median() {
         let mut s = PassStats::of("p", vec![Some(2000.0), Some(4000.0), Some(3000.0)])
-            .with_work(Some(1000), Some(6000));
+            .with_work(Some(&work(Some(1000), Some(6000))));
         assert_eq!(s.ns_per_texel, Some(3.0));
         assert_eq!(s.gb_per_s, Some(2.0));
-        s = s.with_work(None, Some(0));
+        assert_eq!(s.tags, ["t"]);
+        s = s.with_work(Some(&work(None, Some(0))));
         assert_eq!((s.ns_per_texel, s.gb_per_s), (None, None));
         // No time: no figures, never NaN.
-        let s = PassStats::of("q", vec![]).with_work(Some(10), Some(10));
+        let s = PassStats::of("q", vec![]).with_work(Some(&work(Some(10), Some(10))));
         assert_eq!((s.ns_per_texel, s.gb_per_s), (None, None));
     }
 
