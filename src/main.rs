@@ -338,9 +338,12 @@ enum Command {
         /// Output height in pixels, replacing the scene's.
         #[arg(long)]
         height: Option<u32>,
-        /// What to write: the final image or an intermediate (UV-space views at
-        /// the irradiance resolution, as stored).
-        #[arg(long, value_enum, default_value = "final")]
+        /// What to write: a view with shading of its own (final, diffuse,
+        /// specular, direct, reference, occlusion, depth, normals, albedo,
+        /// regions, test-texture) or any image of the frame graph by name, as
+        /// stored (irradiance, stretch, stretch1…5, blur1…6, prefiltered, …).
+        /// `--view list` prints every view of the scene and exits.
+        #[arg(long, default_value = "final", value_name = "VIEW|list")]
         view: View,
         /// Also write the debug sheet (PNG): the stretch and blur levels (the
         /// paper's Fig. 3), depth, occlusion and specular, labelled.
@@ -1076,6 +1079,12 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
             let file = overrides.apply(file)?;
             let loaded = Scene::load(file)?;
             let ctx = Context::new(&context)?;
+            if opts.view.name() == "list" {
+                for name in dermis::render::views(&ctx, &loaded)? {
+                    println!("{name}");
+                }
+                return Ok(ExitCode::SUCCESS);
+            }
             let output = render_scene(&ctx, &loaded, &opts)?;
             if dump_graph {
                 print!("{}", output.plan);

@@ -22,7 +22,7 @@ fn reference_coverage_matches_the_gpu() {
     let gpu = common::with_gpu(|ctx| {
         let opts = RenderOptions {
             hdr: true,
-            view: View::Direct,
+            view: View::named("direct"),
             ..RenderOptions::default()
         };
         render_scene(ctx, &scene, &opts).unwrap()

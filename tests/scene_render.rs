@@ -269,7 +269,7 @@ fn region_irradiance(occlusion: dermis::scene::file::Occlusion) -> [f32; 10] {
     let scene = Scene::load(file).unwrap();
     let out = common::with_gpu(|ctx| {
         let opts = RenderOptions {
-            view: View::Irradiance,
+            view: View::named("irradiance"),
             ..RenderOptions::default()
         };
         render_scene(ctx, &scene, &opts).unwrap()
@@ -386,7 +386,7 @@ fn scattering_bleeds_red_into_the_shadow_edge() {
     file.render.irradiance_resolution = 1024;
     file.render.exposure = Some(0.0);
     let scene = Scene::load(file).unwrap();
-    let [direct, skin] = [View::Direct, View::Final].map(|view| {
+    let [direct, skin] = [View::named("direct"), View::FINAL].map(|view| {
         common::with_gpu(|ctx| {
             let opts = RenderOptions {
                 view,

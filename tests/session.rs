@@ -54,10 +54,10 @@ fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
     common::with_gpu(|ctx| {
         let mut fresh = Session::new(ctx, scene.clone()).unwrap();
         assert!(fresh.extracted_lights() > 0);
-        let (first, _) = fresh.render(View::Final).unwrap();
+        let (first, _) = fresh.render(&View::FINAL).unwrap();
         let expected = pixels(ctx, &first);
         // The next frame reuses all that is kept: the same image.
-        let (again, _) = fresh.render(View::Final).unwrap();
+        let (again, _) = fresh.render(&View::FINAL).unwrap();
         assert_eq!(
             differing(&pixels(ctx, &again), &expected),
             0,
@@ -66,14 +66,14 @@ fn a_session_computes_what_it_keeps_when_a_view_first_needs_it() {
         // Views that skip the chain, the prefilter, or the shadows and the
         // chain; then the full frame computes what they skipped.
         for view in [
-            View::Depth,
-            View::Direct,
-            View::Irradiance,
-            View::Prefiltered,
+            View::named("depth"),
+            View::named("direct"),
+            View::named("irradiance"),
+            View::named("prefiltered"),
         ] {
             let mut session = Session::new(ctx, scene.clone()).unwrap();
-            session.render(view).unwrap();
-            let (image, _) = session.render(View::Final).unwrap();
+            session.render(&view).unwrap();
+            let (image, _) = session.render(&View::FINAL).unwrap();
             let n = differing(&pixels(ctx, &image), &expected);
             assert_eq!(n, 0, "final after {}: bytes differing", view.name());
         }
@@ -87,13 +87,13 @@ fn turning_the_environment_in_a_session_is_a_fresh_session_at_that_angle() {
     turned.file.environment.rotation_deg = 120.0;
     common::with_gpu(|ctx| {
         let mut fresh = Session::new(ctx, turned.clone()).unwrap();
-        let (image, _) = fresh.render(View::Final).unwrap();
+        let (image, _) = fresh.render(&View::FINAL).unwrap();
         let expected = pixels(ctx, &image);
         let mut session = Session::new(ctx, scene.clone()).unwrap();
-        let (image, _) = session.render(View::Final).unwrap();
+        let (image, _) = session.render(&View::FINAL).unwrap();
         let before = pixels(ctx, &image);
         session.set_rotation(120.0).unwrap();
-        let (image, _) = session.render(View::Final).unwrap();
+        let (image, _) = session.render(&View::FINAL).unwrap();
         let after = pixels(ctx, &image);
         assert_eq!(differing(&after, &expected), 0, "turned in the session");
         // The lamps moved: the image changed.
@@ -113,9 +113,9 @@ fn a_session_shows_uv_views_as_render_writes_them() {
     let scene = scan((64, 80));
     let (shown, written) = common::with_gpu(|ctx| {
         let mut session = Session::new(ctx, scene.clone()).unwrap();
-        let (image, _) = session.render(View::Irradiance).unwrap();
+        let (image, _) = session.render(&View::named("irradiance")).unwrap();
         let opts = dermis::render::RenderOptions {
-            view: View::Irradiance,
+            view: View::named("irradiance"),
             ..Default::default()
         };
         let out = dermis::render::render_scene(ctx, &scene, &opts).unwrap();
@@ -154,14 +154,14 @@ fn a_session_after_set_camera_is_a_fresh_session_with_that_camera() {
     let c = &mut moved.camera;
     c.position = c.target + 0.7 * (c.position - c.target);
     common::with_gpu(|ctx| {
-        for view in [View::Final, View::Depth] {
+        for view in [View::FINAL, View::named("depth")] {
             let mut fresh = Session::new(ctx, moved.clone()).unwrap();
-            let (image, _) = fresh.render(view).unwrap();
+            let (image, _) = fresh.render(&view).unwrap();
             let expected = pixels(ctx, &image);
             let mut session = Session::new(ctx, small.clone()).unwrap();
-            session.render(view).unwrap();
+            session.render(&view).unwrap();
             session.set_camera(moved.camera, (96, 120)).unwrap();
-            let (image, _) = session.render(view).unwrap();
+            let (image, _) = session.render(&view).unwrap();
             let n = differing(&pixels(ctx, &image), &expected);
             assert_eq!(n, 0, "{}: bytes differing", view.name());
         }

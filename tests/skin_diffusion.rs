@@ -76,7 +76,7 @@ fn chain_with(
             Some(Access::ShaderSampled),
             None,
         );
-        let st = stretch.pass(&mut g, &buffers, &blur, true);
+        let st = stretch.pass(&mut g, &buffers, &blur);
         let blurred = blur.chain(&mut g, &input, &st, &plan);
         let levels = BlurChain::select(&input, &blurred, &plan);
         for (level, buf) in levels.iter().zip(&readbacks) {
@@ -352,7 +352,11 @@ fn diffuse_term(set: impl Fn(&mut dermis::scene::file::Skin), direct: bool) -> V
     common::with_gpu(|ctx| {
         let opts = RenderOptions {
             hdr: true,
-            view: if direct { View::Direct } else { View::Diffuse },
+            view: if direct {
+                View::named("direct")
+            } else {
+                View::named("diffuse")
+            },
             ..RenderOptions::default()
         };
         render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()

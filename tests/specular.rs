@@ -208,7 +208,7 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
             vec![light],
             EnvMap::uniform(Vec3::ZERO, 64, 32),
         );
-        let img = render(&s, View::Specular);
+        let img = render(&s, View::named("specular"));
         let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
             .into_iter()
             .map(|h| {
@@ -314,7 +314,7 @@ impl ShadowScene {
 #[test]
 fn shadow_maps_match_analytic_shadows_in_screen_space() {
     let s = ShadowScene::new();
-    let img = render(&s.scene, View::Direct);
+    let img = render(&s.scene, View::named("direct"));
     let hits = pixel_hits(&s.scene.camera, &[s.big, s.small]);
     let expected: Vec<Option<f32>> = hits
         .iter()
@@ -381,7 +381,7 @@ fn soft_shadows_follow_the_source_size() {
         shadow: true,
         angular_radius: alpha,
     }];
-    let img = render(&scene, View::Direct);
+    let img = render(&scene, View::named("direct"));
     let hits = pixel_hits(&scene.camera, &[s.big, s.small]);
     let peak = ALBEDO / std::f32::consts::PI * 3.0;
     // Per compared pixel: (GPU, ray-cast reference, a hard shadow), / peak.
@@ -441,7 +441,7 @@ fn soft_shadows_follow_the_source_size() {
 #[test]
 fn shadow_maps_shadow_the_texture_space_irradiance() {
     let s = ShadowScene::new();
-    let img = render(&s.scene, View::Irradiance);
+    let img = render(&s.scene, View::named("irradiance"));
     let res = s.scene.file.render.irradiance_resolution as usize;
     let mix = s.scene.file.skin.mix;
     // A(cos θ, m) by the CPU quadrature at 257 angles, interpolated linearly: A
@@ -490,7 +490,7 @@ fn environment_specular_is_exact_under_a_constant_environment() {
         Vec::new(),
         EnvMap::uniform(Vec3::splat(radiance), 64, 32),
     );
-    let img = render(&s, View::Specular);
+    let img = render(&s, View::named("specular"));
     let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
         .into_iter()
         .map(|h| {
@@ -514,7 +514,7 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
         Vec::new(),
         EnvMap::uniform(Vec3::splat(radiance), 64, 32),
     );
-    let img = render(&s, View::Irradiance);
+    let img = render(&s, View::named("irradiance"));
     let want = std::f32::consts::PI
         * radiance
         * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M))
@@ -544,7 +544,7 @@ fn prefilter_errors(dir: &std::path::Path, name: &str, lights: LightsMode) -> Ve
     );
     s.file.environment.lights = lights;
     let env = extract(&map, lights).residual;
-    let img = render(&s, View::Prefiltered);
+    let img = render(&s, View::named("prefiltered"));
     let w = prefilter::WIDTH;
     let mut errors = Vec::new();
     for k in [0, 2, 5] {
@@ -600,7 +600,7 @@ fn the_scans_specular_share_under_a_uniform_sky() {
     file.render.height = 120;
     file.render.irradiance_resolution = 512;
     let scene = Scene::load(file).unwrap();
-    let [total, specular] = [View::Final, View::Specular].map(|view| render(&scene, view));
+    let [total, specular] = [View::FINAL, View::named("specular")].map(|view| render(&scene, view));
     let mean = |img: &[f32]| {
         let (sum, n) = img
             .chunks_exact(4)

@@ -143,7 +143,7 @@ fn the_adaptive_chain_stays_within_half_a_percent_of_the_full_chain() {
             scene.file.skin.chain = chain;
             let opts = RenderOptions {
                 hdr: true,
-                view: View::Final,
+                view: View::FINAL,
                 ..RenderOptions::default()
             };
             render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()

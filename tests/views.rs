@@ -7,7 +7,7 @@ mod common;
 
 use dermis::render::sheet::{COLUMNS, TILE};
 use dermis::render::{
-    compare_occlusion, debug_sheet, render_scene, RenderOptions, View, SHEET_VIEWS,
+    compare_occlusion, debug_sheet, render_scene, sheet_views, views, RenderOptions, Screen, View,
 };
 use dermis::scene::file::SceneFile;
 use dermis::scene::Scene;
@@ -31,13 +31,35 @@ fn colours(rgba8: &[u8]) -> usize {
 }
 
 #[test]
+fn the_view_list_names_every_screen_view_and_the_papers_intermediates() {
+    let scene = scene();
+    let names = common::with_gpu(|ctx| views(ctx, &scene).unwrap());
+    let wanted = Screen::all()
+        .map(|s| s.name().to_string())
+        .chain(["irradiance", "prefiltered", "hdr"].map(String::from))
+        .chain((0..6).map(dermis::skin::stretch::level_name))
+        .chain((1..=6).map(dermis::skin::blur::BlurChain::level_name));
+    for name in wanted {
+        assert!(names.contains(&name), "{name} missing from {names:?}");
+    }
+    let mut unique = names.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), names.len(), "{names:?}");
+}
+
+#[test]
 fn every_view_renders_and_shows_something() {
     let scene = scene();
     common::with_gpu(|ctx| {
         // The reference is the CPU's (tests/reference_gpu.rs, light::reference).
-        for view in View::ALL.into_iter().filter(|&v| v != View::Reference) {
+        let names = views(ctx, &scene).unwrap();
+        for view in names.iter().map(|n| View::named(n)) {
+            if view == View::Screen(Screen::Reference) {
+                continue;
+            }
             let opts = RenderOptions {
-                view,
+                view: view.clone(),
                 ..RenderOptions::default()
             };
             let out = render_scene(ctx, &scene, &opts).unwrap();
@@ -54,7 +76,7 @@ fn every_view_renders_and_shows_something() {
                 assert_eq!((out.width, out.height), SIZE, "{}", view.name());
             }
             // Region ids: ten colours and the background; the rest vary smoothly.
-            let least = if view == View::Regions { 5 } else { 32 };
+            let least = if view.name() == "regions" { 5 } else { 32 };
             assert!(n >= least, "{}: {n} colours", view.name());
         }
     });
@@ -70,12 +92,13 @@ fn the_debug_sheet_and_the_occlusion_comparison_are_labelled_images_of_their_vie
             compare_occlusion(ctx, &scene, &opts).unwrap(),
         )
     });
-    let rows = SHEET_VIEWS.len().div_ceil(COLUMNS) as u32;
+    let sheet_views = sheet_views();
+    let rows = sheet_views.len().div_ceil(COLUMNS) as u32;
     assert_eq!(sheet.width, COLUMNS as u32 * TILE.0);
     assert!(sheet.height > rows * TILE.1 && sheet.height < rows * (TILE.1 + 40));
     // Every tile shows its view: many colours inside each tile.
     let cell_h = sheet.height / rows;
-    for (i, view) in SHEET_VIEWS.iter().enumerate() {
+    for (i, view) in sheet_views.iter().enumerate() {
         let (x0, y0) = ((i % COLUMNS) as u32 * TILE.0, (i / COLUMNS) as u32 * cell_h);
         let tile: Vec<u8> = (y0..y0 + TILE.1)
             .flat_map(|y| {
@@ -174,7 +197,7 @@ fn uv_views_are_written_as_the_scans_maps_are_authored() {
     let scene = Scene::load(file).unwrap();
     let out = common::with_gpu(|ctx| {
         let opts = RenderOptions {
-            view: View::Irradiance,
+            view: View::named("irradiance"),
             hdr: true,
             ..RenderOptions::default()
         };
@@ -195,4 +218,88 @@ fn uv_views_are_written_as_the_scans_maps_are_authored() {
     println!("coverage agrees with the UVs at v = 1 on top: {authored:.4}, at v = 0: {stored:.4}");
     // The layout is near symmetric top to bottom: upside down, 9 % of texels differ.
     assert!(authored > 0.995 && stored < 0.95, "{authored} {stored}");
+}
+
+/// The passes a view's frame ran (its first frame: what it keeps included).
+fn passes(ctx: &std::sync::Arc<dermis::gpu::Context>, scene: &Scene, view: &str) -> Vec<String> {
+    let opts = RenderOptions {
+        view: View::named(view),
+        ..RenderOptions::default()
+    };
+    let out = render_scene(ctx, scene, &opts).unwrap();
+    let frame = &out.report.per_frame[0];
+    frame.passes.iter().map(|p| p.name.clone()).collect()
+}
+
+#[test]
+fn each_view_runs_only_the_passes_it_depends_on() {
+    let scene = scene();
+    common::with_gpu(|ctx| {
+        let has = |passes: &[String], name: &str| passes.iter().any(|p| p == name);
+        let chain = |passes: &[String]| {
+            passes
+                .iter()
+                .filter(|p| p.starts_with("blur") || p.starts_with("stretch"))
+                .count()
+        };
+        let all = passes(ctx, &scene, "final");
+        for name in [
+            "sh_project",
+            "shadow maps",
+            "stretch",
+            "irradiance",
+            "env_prefilter",
+        ] {
+            assert!(has(&all, name), "final lacks {name}: {all:?}");
+        }
+        for name in ["skin", "tonemap", "readback"] {
+            assert!(has(&all, name), "final lacks {name}: {all:?}");
+        }
+        assert!(chain(&all) >= 12, "{all:?}");
+
+        let irradiance = passes(ctx, &scene, "irradiance");
+        assert_eq!(chain(&irradiance), 0, "{irradiance:?}");
+        assert!(has(&irradiance, "irradiance") && has(&irradiance, "sh_project"));
+        for name in ["env_prefilter", "skin", "tonemap", "background"] {
+            assert!(
+                !has(&irradiance, name),
+                "irradiance ran {name}: {irradiance:?}"
+            );
+        }
+
+        let stretch = passes(ctx, &scene, "stretch3");
+        assert!(
+            has(&stretch, "stretch") && has(&stretch, "stretch3_v"),
+            "{stretch:?}"
+        );
+        for name in ["stretch4_u", "irradiance", "sh_project", "shadow maps"] {
+            assert!(!has(&stretch, name), "stretch3 ran {name}: {stretch:?}");
+        }
+
+        let depth = passes(ctx, &scene, "depth");
+        assert!(has(&depth, "debug_view"), "{depth:?}");
+        for name in [
+            "sh_project",
+            "shadow maps",
+            "light_visibility",
+            "irradiance",
+        ] {
+            assert!(!has(&depth, name), "depth ran {name}: {depth:?}");
+        }
+        assert_eq!(chain(&depth), 0);
+
+        let prefiltered = passes(ctx, &scene, "prefiltered");
+        assert_eq!(prefiltered, ["env_prefilter", "readback"]);
+    });
+}
+
+#[test]
+fn the_chain_passes_carry_the_diffusion_tag() {
+    let scene = scene();
+    let out = common::with_gpu(|ctx| render_scene(ctx, &scene, &RenderOptions::default()).unwrap());
+    for p in &out.report.per_frame[0].passes {
+        let chain = p.name.starts_with("blur") || p.name.starts_with("stretch");
+        let tagged = p.tags.iter().any(|t| t == dermis::skin::TAG);
+        assert_eq!(chain, tagged, "{}: {:?}", p.name, p.tags);
+    }
 }

@@ -163,11 +163,7 @@ impl Graph {
             .enumerate()
             .map(|(i, r)| (r.name.as_str(), i));
         let aliases = self.aliases.iter().map(|(n, i)| (n.as_str(), *i));
-        let id = own
-            .chain(aliases)
-            .filter(|(n, _)| *n == name)
-            .map(|(_, i)| i)
-            .last()?;
+        let id = own.chain(aliases).rfind(|(n, _)| *n == name)?.1;
         match self.resources[id].kind {
             ResourceKind::Image(desc) => Some(ImageHandle { id, desc }),
             ResourceKind::Buffer(_) => None,

@@ -18,6 +18,18 @@ pub enum DirectView {
     Occlusion,
 }
 
+impl DirectView {
+    pub const ALL: [DirectView; 2] = [DirectView::Shading, DirectView::Occlusion];
+
+    /// The view's name (`render --view`), also its pass's.
+    pub fn name(self) -> &'static str {
+        match self {
+            DirectView::Shading => "direct",
+            DirectView::Occlusion => "occlusion",
+        }
+    }
+}
+
 pub struct DirectPass {
     shading: Arc<Pipeline>,
     occlusion: Arc<Pipeline>,
@@ -63,8 +75,8 @@ impl DirectPass {
         hdr: &mut ImageHandle,
     ) {
         let (pipeline, name) = match view {
-            DirectView::Shading => (&self.shading, "direct"),
-            DirectView::Occlusion => (&self.occlusion, "occlusion"),
+            DirectView::Shading => (&self.shading, view.name()),
+            DirectView::Occlusion => (&self.occlusion, view.name()),
         };
         let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));

@@ -4,6 +4,7 @@
 
 pub mod direct;
 pub mod extract;
+pub mod lighting;
 pub mod occlusion;
 pub mod prefilter;
 pub mod reference;
@@ -12,3 +13,6 @@ pub mod sh_pass;
 pub mod shadow;
 pub mod skybox;
 pub mod visibility;
+
+/// The tag of the lighting passes (SH, prefilter, shadows, direct lighting).
+pub const TAG: &str = "lighting";

@@ -54,18 +54,19 @@ impl PrefilterPass {
     }
 
     /// The prefiltered environment of `env` (with its mip chain), `WIDTH` ×
-    /// `HEIGHT·LEVELS`, level k in rows [k·HEIGHT, (k+1)·HEIGHT). `first`: the
-    /// render's first frame, which adds the `env_prefilter` pass that fills it;
-    /// later frames import it as it was left.
-    pub fn pass(&self, g: &mut Graph, env: &Arc<Image>, first: bool) -> ImageHandle {
-        let mut out = g.import_image(
-            "specular environment",
+    /// `HEIGHT·LEVELS`, level k in rows [k·HEIGHT, (k+1)·HEIGHT), kept: the
+    /// environment is fixed for a render, so the `env_prefilter` pass fills it
+    /// once, in the first frame that needs it.
+    pub fn pass(&self, g: &mut Graph, env: &Arc<Image>) -> ImageHandle {
+        let (mut out, first) = g.import_kept_image(
+            "prefiltered",
             Imported::Image(self.image.clone()),
-            (!first).then_some(Access::ShaderSampled),
-            Some(Access::ShaderSampled),
+            Access::ShaderSampled,
+            0,
         );
         if first {
             g.simple_pass("env_prefilter", &self.pipeline)
+                .tag(super::TAG)
                 .texture(env, &self.sampler)
                 .store(&mut out)
                 .dispatch([WIDTH, HEIGHT * LEVELS, 1]);

@@ -42,6 +42,9 @@ pub struct ShBuffers {
     /// Nine vec4 (rgb, 0): rotated and scaled coefficients.
     pub coefficients: Arc<Buffer>,
     rows: u32,
+    /// What the transform was made from (light::lighting::key): the
+    /// coefficients are kept for it.
+    key: u64,
 }
 
 impl ShBuffers {
@@ -57,28 +60,49 @@ impl ShBuffers {
             )
             .map(Arc::new)
         };
-        let mut transform: Vec<f32> = rotation_matrix(rotation_deg).to_vec();
-        transform.push(intensity);
         Ok(Self {
             partials: storage(
                 "sh partials",
                 rows as u64 * 27 * 4,
                 vk::BufferUsageFlags::empty(),
             )?,
-            transform: upload_buffer(
-                ctx,
-                "sh transform",
-                bytemuck::cast_slice(&transform),
-                Access::ComputeBufferRead,
-            )?,
+            transform: transform(ctx, rotation_deg, intensity)?,
             coefficients: storage(
                 "sh coefficients",
                 9 * 16,
                 vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::UNIFORM_BUFFER,
             )?,
             rows,
+            key: super::lighting::key(&[rotation_deg, intensity]),
         })
     }
+}
+
+impl ShBuffers {
+    /// The environment turned or scaled: a new transform; the coefficients
+    /// are projected again by the next frame that needs them.
+    pub fn set_transform(
+        &mut self,
+        ctx: &Arc<Context>,
+        rotation_deg: f32,
+        intensity: f32,
+    ) -> Result<()> {
+        self.transform = transform(ctx, rotation_deg, intensity)?;
+        self.key = super::lighting::key(&[rotation_deg, intensity]);
+        Ok(())
+    }
+}
+
+/// The 9×9 rotation, then the intensity, uploaded.
+fn transform(ctx: &Arc<Context>, rotation_deg: f32, intensity: f32) -> Result<Arc<Buffer>> {
+    let mut transform: Vec<f32> = rotation_matrix(rotation_deg).to_vec();
+    transform.push(intensity);
+    upload_buffer(
+        ctx,
+        "sh transform",
+        bytemuck::cast_slice(&transform),
+        Access::ComputeBufferRead,
+    )
 }
 
 impl ShPasses {
@@ -90,23 +114,14 @@ impl ShPasses {
         })
     }
 
-    /// Adds `sh_project` and `sh_reduce`; returns the coefficient buffer, written.
-    /// `readers`: the access the previous frame's readers used (for the first
-    /// barrier). `project`: false keeps the coefficients a previous frame wrote (the
-    /// environment and its rotation are fixed for a render).
-    pub fn passes(
-        &self,
-        g: &mut Graph,
-        env: &Arc<Image>,
-        b: &ShBuffers,
-        readers: Access,
-        project: bool,
-    ) -> BufferHandle {
-        let mut coefficients = g.import_buffer(
+    /// The coefficient buffer, kept (read as a uniform buffer): `sh_project`
+    /// and `sh_reduce` compute it when the transform is new.
+    pub fn passes(&self, g: &mut Graph, env: &Arc<Image>, b: &ShBuffers) -> BufferHandle {
+        let (mut coefficients, project) = g.import_kept_buffer(
             "sh coefficients",
             Imported::Buffer(b.coefficients.clone()),
-            Some(readers),
-            None,
+            Access::UniformRead,
+            b.key,
         );
         if !project {
             return coefficients;
@@ -121,8 +136,10 @@ impl ShPasses {
         g.simple_pass("sh_project", &self.project)
             .texture(env, &self.sampler)
             .write_buffer(&mut partials)
+            .tag(super::TAG)
             .dispatch_groups([b.rows, 1, 1]);
         g.simple_pass("sh_reduce", &self.reduce)
+            .tag(super::TAG)
             .read_buffer(&partials)
             .buffer(&b.transform)
             .write_buffer(&mut coefficients)
@@ -145,7 +162,7 @@ pub fn project(
     let buffers = ShBuffers::new(ctx, &image, rotation_deg, intensity)?;
     let readback = Readback::new(ctx, "sh readback", 9 * 16)?;
     let mut g = Graph::new();
-    let coefficients = passes.passes(&mut g, &image, &buffers, Access::TransferSrc, true);
+    let coefficients = passes.passes(&mut g, &image, &buffers);
     readback.buffer_pass(&mut g, &coefficients);
     let mut ex = Executor::new(ctx, 1)?;
     let mut reports: Vec<FrameReport> = ex.run(g)?.into_iter().collect();

@@ -175,20 +175,21 @@ impl ShadowPass {
         self.matrices = matrices;
     }
 
-    /// The atlas as a graph image; `draw`: the render's first frame that needs
-    /// it, which draws it (pass `shadow maps`); later frames import it as kept.
-    pub fn pass(&self, g: &mut Graph, mesh: &Arc<MeshBuffers>, draw: bool) -> ImageHandle {
-        let mut atlas = g.import_image(
+    /// The atlas as a graph image, kept for `key` (light::lighting's
+    /// shadow key): drawn (pass `shadow maps`) by the first frame that needs it.
+    pub fn pass(&self, g: &mut Graph, mesh: &Arc<MeshBuffers>, key: u64) -> ImageHandle {
+        let (mut atlas, draw) = g.import_kept_image(
             "shadow atlas",
             Imported::Image(self.atlas.clone()),
-            (!draw).then_some(Access::ShaderSampled),
-            Some(Access::ShaderSampled),
+            Access::ShaderSampled,
+            key,
         );
         if draw {
             let (pipe, mesh) = (self.pipeline.clone(), mesh.clone());
             let (matrices, resolution) = (self.matrices.clone(), self.resolution);
             let (cols, _) = atlas_grid(matrices.len());
             g.simple_pass("shadow maps", &self.pipeline)
+                .tag(super::TAG)
                 .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
                 .record(move |cx| {
                     for (i, m) in matrices.iter().enumerate() {

@@ -75,22 +75,25 @@ impl VisibilityPass {
     }
 
     /// The visibility textures as graph images, from the lights' shadow `atlas`
-    /// (light::shadow); `draw`: the render's first frame that needs them, which
-    /// draws them (pass `light_visibility`).
+    /// (light::shadow), kept for `key` (the atlas's): drawn (pass
+    /// `light_visibility`) by the first frame that needs them.
     pub fn pass(
         &self,
         g: &mut Graph,
         inputs: &FrameInputs,
         atlas: &ImageHandle,
-        draw: bool,
+        key: u64,
     ) -> [ImageHandle; TEXTURES] {
+        let mut draw = false;
         let mut out: [ImageHandle; TEXTURES] = std::array::from_fn(|k| {
-            g.import_image(
+            let (image, stale) = g.import_kept_image(
                 &name(k),
                 Imported::Image(self.textures[k].clone()),
-                (!draw).then_some(Access::ShaderSampled),
-                Some(Access::ShaderSampled),
-            )
+                Access::ShaderSampled,
+                key,
+            );
+            draw |= stale;
+            image
         });
         if !draw {
             return out;
@@ -98,6 +101,7 @@ impl VisibilityPass {
         let s = &inputs.samplers;
         let mut pass = g
             .simple_pass("light_visibility", &self.pipeline)
+            .tag(super::TAG)
             .uniform(&inputs.uniforms)
             .sample(atlas, &s.shadow)
             .sample(atlas, &s.nearest);

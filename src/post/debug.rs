@@ -26,6 +26,33 @@ pub enum DebugView {
     Regions = 3,
 }
 
+impl DebugView {
+    pub const ALL: [DebugView; 4] = [
+        DebugView::Depth,
+        DebugView::Normals,
+        DebugView::Albedo,
+        DebugView::Regions,
+    ];
+
+    /// The view's name (`render --view`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DebugView::Depth => "depth",
+            DebugView::Normals => "normals",
+            DebugView::Albedo => "albedo",
+            DebugView::Regions => "regions",
+        }
+    }
+
+    /// How the view is shown: the albedo is a fraction, the rest data.
+    pub fn shown(self) -> super::Shown {
+        match self {
+            DebugView::Albedo => super::Shown::Fraction,
+            DebugView::Depth | DebugView::Normals | DebugView::Regions => super::Shown::Data,
+        }
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct DebugPush {

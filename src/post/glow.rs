@@ -105,6 +105,7 @@ impl Glow {
             );
             let mut dst = g.create_image(&format!("glow mip{k}"), desc);
             g.simple_pass(&format!("glow_down{k}"), &self.down)
+                .tag(super::TAG)
                 .sample(src, &self.nearest)
                 .store(&mut dst)
                 .dispatch([desc.width, desc.height, 1]);
@@ -126,6 +127,7 @@ impl Glow {
             .collect();
         let mut out = g.create_image("glowed", ImageDesc::new(w, h, HDR_FORMAT));
         g.simple_pass("glow", &self.composite)
+            .tag(super::TAG)
             .sample(hdr, &self.nearest)
             .sample(&blurred[0], &self.linear)
             .sample(&blurred[1], &self.linear)
@@ -149,6 +151,7 @@ impl Glow {
     ) {
         let (w, h) = (dst.desc.width, dst.desc.height);
         g.simple_pass(name, &self.blur)
+            .tag(super::TAG)
             .sample(src, &self.nearest)
             .store(dst)
             .constants(&BlurPush { dir, sigma })

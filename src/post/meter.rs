@@ -160,6 +160,7 @@ impl Meter {
             None,
         );
         g.simple_pass("meter", &self.tiles)
+            .tag(super::TAG)
             .sample(hdr, &self.sampler)
             .write_buffer(&mut partials)
             .constants(&TilePush {
@@ -169,6 +170,7 @@ impl Meter {
             })
             .dispatch_groups([tiles_xy[0], tiles_xy[1], 1]);
         g.simple_pass("meter_reduce", &self.reduce)
+            .tag(super::TAG)
             .read_buffer(&partials)
             .write_buffer(&mut result)
             .constants(&ReducePush {

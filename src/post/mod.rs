@@ -8,6 +8,22 @@ pub mod tonemap;
 
 use crate::scene::file::{Gamma, Render, ToneCurve};
 
+/// The tag of the post-processing passes (meter, glow, tone map).
+pub const TAG: &str = "post";
+
+/// How a view's image becomes display values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shown {
+    /// Radiance: glow, the exposure (given or metered), the scene's tone curve
+    /// and transfer function.
+    Exposed,
+    /// A fraction in [0, 1] (occlusion, albedo): exposure 0, no curve, the
+    /// scene's transfer function.
+    Fraction,
+    /// Data (depth, normals, region colours): the values as they are.
+    Data,
+}
+
 /// Where the exposure comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Exposure {

@@ -132,6 +132,7 @@ impl Tonemap {
     ) {
         let [r, gr, b] = display.background;
         g.simple_pass("tonemap", &self.pipeline)
+            .tag(super::TAG)
             .sample(hdr, &self.sampler)
             .read_buffer(metered)
             .color(ldr, LoadOp::DontCare)

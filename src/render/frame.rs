@@ -1,10 +1,11 @@
 //! One frame of the `render` command: the GPU state shared by every frame of a
-//! render (uploaded scene, pipelines) and the frame graph, pass by pass, for the
-//! final image or a debug view.
+//! render (uploaded scene, passes and their pipelines, resolved settings) and
+//! the assembly of the frame graph. A view is an output the graph is asked
+//! for; the graph runs only the passes it depends on (graph::cull), and what
+//! a render computes once is kept by key (graph::Kept).
 
 use super::ruler::Ruler;
-use super::view::Shown;
-use super::View;
+use super::view::{Screen, Shown, View};
 use crate::error::{Error, Result};
 use crate::frame::{
     upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, ShaderVariant,
@@ -13,21 +14,22 @@ use crate::frame::{
 use crate::gpu::{Context, ImageDesc};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle};
-use crate::light::direct::{DirectPass, DirectView};
-use crate::light::extract::{extract, ExtractedLight};
+use crate::light::direct::DirectPass;
+use crate::light::extract::extract;
+use crate::light::lighting::Lighting;
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
-use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
+use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass};
 use crate::light::skybox::SkyboxPass;
-use crate::light::visibility::VisibilityPass;
-use crate::post::debug::{DebugPass, DebugView, DepthRange};
+use crate::light::visibility::{VisibilityPass, TEXTURES};
+use crate::post::debug::{DebugPass, DepthRange};
 use crate::post::glow::Glow;
 use crate::post::meter::Meter;
 use crate::post::tonemap::{Tonemap, LDR_FORMAT};
 use crate::post::{Display, Exposure, PostSettings};
-use crate::scene::file::{Occlusion, ToneCurve};
+use crate::scene::file::ToneCurve;
 use crate::scene::texture::Texture;
-use crate::scene::{Light, LightSource, Scene};
+use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::chain::{self, Level};
 use crate::skin::irradiance::IrradiancePass;
@@ -37,35 +39,8 @@ use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
 use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
+use glam::Vec3;
 use std::sync::Arc;
-
-/// The lights the frame uses, at most [`MAX_LIGHTS`]: the scene's, then the
-/// environment's bright sources (`extracted`, in the map's frame) as shadowed
-/// directional lights of their power, turned and scaled like the environment.
-fn frame_lights(scene: &Scene, extracted: &[ExtractedLight]) -> Vec<Light> {
-    let env = &scene.file.environment;
-    let all: Vec<Light> = scene
-        .lights
-        .iter()
-        .copied()
-        .chain(extracted.iter().map(|x| Light {
-            source: LightSource::Directional(x.world_direction(env.rotation_deg)),
-            // A uniform cap of radius α delivers (1 + cos α)/2 of its ∫L dω to a
-            // surface facing it.
-            irradiance: x.power * env.intensity * 0.5 * (1.0 + x.angular_radius_rad.cos()),
-            shadow: true,
-            angular_radius: x.angular_radius_rad,
-        }))
-        .collect();
-    if all.len() > MAX_LIGHTS {
-        log::warn!(
-            "only the first {MAX_LIGHTS} of {} lights ({} from the environment) are used",
-            all.len(),
-            extracted.len()
-        );
-    }
-    all.into_iter().take(MAX_LIGHTS).collect()
-}
 
 /// Where the depth view's 1 and 0 lie: the mesh's nearest and farthest vertex
 /// along the camera's axis.
@@ -78,41 +53,17 @@ fn depth_range(scene: &Scene) -> DepthRange {
     )
 }
 
-/// The shadow projection of each light (`None`: unshadowed).
-fn shadow_views(scene: &Scene, lights: &[Light]) -> Vec<Option<ShadowView>> {
-    let (lo, hi) = scene.mesh.bounds().unwrap_or_default();
-    let (centre, radius) = (0.5 * (lo + hi), 0.5 * lo.distance(hi));
-    let res = scene.file.render.shadow_resolution;
-    lights
-        .iter()
-        .map(|l| {
-            let view = l
-                .shadow
-                .then(|| ShadowView::fit(l.source, centre, radius, res))
-                .flatten();
-            if l.shadow && view.is_none() {
-                log::warn!(
-                    "{:?} is inside the mesh's bounding sphere (radius {radius:.0} mm): \
-                     one shadow map cannot hold every direction; it casts no shadow",
-                    l.source
-                );
-            }
-            view
-        })
-        .collect()
-}
-
-/// The frame's uniforms: camera, environment rotation and intensity, lights and
-/// their shadow projections (`views`, from [`shadow_views`]).
+/// The frame's uniforms: camera at `aspect`, the environment's rotation and
+/// intensity, the lights and their shadow projections; `specular_scale`: 0.5
+/// over the specular map's mean.
 fn frame_uniforms(
     scene: &Scene,
-    lights: &[Light],
+    lighting: &Lighting,
     aspect: f32,
-    views: &[Option<ShadowView>],
+    specular_scale: f32,
 ) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
-    let env = &scene.file.environment;
-    let tiles = views.iter().flatten().count();
+    let tiles = lighting.views.iter().flatten().count();
     let mut u = FrameUniforms {
         view_proj: vp.to_cols_array_2d(),
         inv_view_proj: vp.inverse().to_cols_array_2d(),
@@ -122,33 +73,20 @@ fn frame_uniforms(
         light_shadow: [[[0.0; 4]; 4]; MAX_LIGHTS],
         light_params: [[0.0; 4]; MAX_LIGHTS],
         env: [
-            env.rotation_deg.to_radians(),
-            env.intensity,
+            lighting.rotation_deg.to_radians(),
+            lighting.intensity,
             0.0,
-            if scene.file.skin.occlusion == Occlusion::Off {
-                0.0
-            } else {
-                1.0
-            },
+            if lighting.occlusion { 1.0 } else { 0.0 },
         ],
         params: [
             0.0,
-            0.5 / specular::map_mean(
-                &scene.mesh.positions,
-                &scene.mesh.uvs,
-                &scene.mesh.indices,
-                (
-                    scene.specular.width,
-                    scene.specular.height,
-                    &scene.specular.rgba8,
-                ),
-            ),
+            specular_scale,
             atlas_grid(tiles).0 as f32,
             atlas_grid(tiles).1 as f32,
         ],
     };
     let mut tile = 0;
-    for (i, (l, view)) in lights.iter().zip(views).enumerate() {
+    for (i, (l, view)) in lighting.lights.iter().zip(&lighting.views).enumerate() {
         u.light_vec[i] = match l.source {
             LightSource::Directional(d) => d.extend(0.0),
             LightSource::Point(p) => p.extend(1.0),
@@ -168,10 +106,72 @@ fn frame_uniforms(
     u
 }
 
-/// GPU state shared by every frame of a render: uploaded scene and pipelines.
-pub(super) struct Frame {
-    inputs: FrameInputs,
-    tables: SpecularTables,
+/// The scene uploaded for the frame's passes, lit by `lighting`.
+fn frame_inputs(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    albedo: &Texture,
+    lighting: &Lighting,
+    residual: Option<&crate::scene::env::EnvMap>,
+    uniforms: &FrameUniforms,
+) -> Result<FrameInputs> {
+    let samplers = Arc::new(Samplers::new(ctx)?);
+    let env = upload_env(ctx, &scene.env)?;
+    let (lights, views) = (&lighting.lights, &lighting.views);
+    // Bit i set where light i has `has`.
+    let bits = |has: &dyn Fn(usize) -> bool| {
+        (0..lights.len())
+            .filter(|&i| has(i))
+            .fold(0, |b, i| b | 1 << i)
+    };
+    let transfer =
+        crate::light::occlusion::transfer_for(ctx, &scene.mesh, scene.file.skin.occlusion)?;
+    Ok(FrameInputs {
+        uniforms: upload_buffer(
+            ctx,
+            "frame uniforms",
+            bytemuck::bytes_of(uniforms),
+            Access::UniformRead,
+        )?,
+        mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
+        albedo: upload_rgba8(ctx, "albedo", albedo)?,
+        normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
+        transfer: upload_buffer(
+            ctx,
+            "transfer",
+            bytemuck::cast_slice(&transfer.coeffs),
+            Access::ShaderBufferRead,
+        )?,
+        specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
+        roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
+        variant: ShaderVariant {
+            lights: lights.len() as u32,
+            occlusion: lighting.occlusion,
+            roughness_map: scene.file.textures.roughness.is_some(),
+            shadowed: bits(&|i| views[i].is_some()),
+            // Soft shadows where the map can take them: directional (linear depth).
+            soft: bits(&|i| {
+                views[i].is_some()
+                    && lights[i].angular_radius > 0.0
+                    && matches!(lights[i].source, LightSource::Directional(_))
+            }),
+        },
+        lighting_env: match residual {
+            Some(r) => upload_env(ctx, r)?,
+            None => env.clone(),
+        },
+        env,
+        env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
+            samplers.linear.clone()
+        } else {
+            samplers.nearest.clone()
+        },
+        samplers,
+    })
+}
+
+/// The frame's passes, each with its pipelines.
+struct Passes {
     skybox: SkyboxPass,
     direct: DirectPass,
     stretch: StretchMaps,
@@ -180,29 +180,78 @@ pub(super) struct Frame {
     shade: ShadePass,
     shadow: ShadowPass,
     visibility: VisibilityPass,
-    /// The frame's lights (the scene's, then the extracted sources) and each
-    /// one's shadow projection: the uniforms are made from them.
-    lights: Vec<Light>,
-    views: Vec<Option<ShadowView>>,
     prefilter: PrefilterPass,
     debug: DebugPass,
-    /// Where the depth view's 1 and 0 lie.
-    depth_range: DepthRange,
     meter: Meter,
     glow: Glow,
     tonemap: Tonemap,
     sh: ShPasses,
-    sh_buffers: ShBuffers,
-    skin: SkinSettings,
-    /// The blur levels' resolutions (skin::chain).
-    levels: Vec<Level>,
     /// Timed beside the chain, over the irradiance (render --ruler).
     ruler: Option<Ruler>,
+}
+
+impl Passes {
+    fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        inputs: &FrameInputs,
+        lighting: &Lighting,
+        skin: &SkinSettings,
+        ruler: bool,
+    ) -> Result<Self> {
+        let (variant, s) = (&inputs.variant, &inputs.samplers);
+        let res = skin.resolution;
+        let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
+        Ok(Self {
+            skybox: SkyboxPass::new(ctx)?,
+            direct: DirectPass::new(ctx, variant)?,
+            stretch: StretchMaps::new(ctx, res, &skin.profile, constant_stretch)?,
+            irradiance: IrradiancePass::new(ctx, variant)?,
+            blur: BlurChain::new(ctx, &skin.kernel, s.linear.clone())?,
+            shade: ShadePass::new(ctx, variant)?,
+            shadow: ShadowPass::new(ctx, &lighting.views, lighting.shadow_resolution)?,
+            visibility: VisibilityPass::new(ctx, variant, res)?,
+            prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
+            debug: DebugPass::new(ctx, &scene.regions)?,
+            meter: Meter::new(ctx, s.nearest.clone())?,
+            glow: Glow::new(ctx, s.nearest.clone(), s.linear.clone())?,
+            tonemap: Tonemap::new(ctx, s.nearest.clone())?,
+            sh: ShPasses::new(ctx, s.nearest.clone())?,
+            ruler: match ruler {
+                true => Some(Ruler::new(ctx, s.nearest.clone())?),
+                false => None,
+            },
+        })
+    }
+}
+
+/// GPU state shared by every frame of a render: uploaded scene, passes and
+/// the settings resolved once.
+pub(super) struct Frame {
+    inputs: FrameInputs,
+    tables: SpecularTables,
+    passes: Passes,
+    lighting: Lighting,
+    sh_buffers: ShBuffers,
+    skin: SkinSettings,
+    /// The six Gaussians' RGB weights (the paper's Fig. 2).
+    weights: [Vec3; 6],
+    /// The blur levels' resolutions (skin::chain).
+    levels: Vec<Level>,
+    /// 0.5 over the specular map's mean (frame uniforms).
+    specular_scale: f32,
     /// render.skybox: draw the environment behind the head.
     skybox_on: bool,
+    /// Where the depth view's 1 and 0 lie.
+    depth_range: DepthRange,
     pub(super) post: PostSettings,
-    /// Bright sources taken out of the environment as lights (in the map's frame).
-    pub(super) extracted: Vec<ExtractedLight>,
+}
+
+/// The lighting images every shading pass reads.
+struct LightImages {
+    sh: BufferHandle,
+    shadows: ImageHandle,
+    soft: [ImageHandle; TEXTURES],
 }
 
 impl Frame {
@@ -215,7 +264,6 @@ impl Frame {
         ruler: bool,
     ) -> Result<Self> {
         let (w, h) = (scene.file.render.width, scene.file.render.height);
-        let samplers = Arc::new(Samplers::new(ctx)?);
         // The environment's bright sources become lights; the rest lights the
         // skin through SH9 and the prefilter, while the skybox shows it whole.
         let extraction = extract(&scene.env, scene.file.environment.lights);
@@ -226,128 +274,63 @@ impl Frame {
                 2.0 * l.angular_radius_rad.to_degrees()
             );
         }
-        let lights = frame_lights(scene, &extraction.lights);
-        let views = shadow_views(scene, &lights);
-        let shadow_res = scene.file.render.shadow_resolution;
-        let tiles = views.iter().flatten().count();
+        let residual = (!extraction.lights.is_empty()).then_some(&extraction.residual);
+        let lighting = Lighting::resolve(scene, extraction.lights.clone());
+        let tiles = lighting.views.iter().flatten().count();
         let (cols, rows) = atlas_grid(tiles);
-        super::check_target(&ctx.info, shadow_res * cols, shadow_res * rows).map_err(|e| {
+        let res = lighting.shadow_resolution;
+        super::check_target(&ctx.info, res * cols, res * rows).map_err(|e| {
             Error::Input(format!(
-                "shadow atlas of {tiles} light(s) at render.shadow_resolution = {shadow_res}: {e}"
+                "shadow atlas of {tiles} light(s) at render.shadow_resolution = {res}: {e}"
             ))
         })?;
-        let uniforms = frame_uniforms(scene, &lights, w as f32 / h as f32, &views);
-        let env = upload_env(ctx, &scene.env)?;
-        // Bit i set where light i has `has`.
-        let bits = |has: &dyn Fn(usize) -> bool| {
-            (0..lights.len())
-                .filter(|&i| has(i))
-                .fold(0, |b, i| b | 1 << i)
-        };
-        let inputs = FrameInputs {
-            uniforms: upload_buffer(
-                ctx,
-                "frame uniforms",
-                bytemuck::bytes_of(&uniforms),
-                Access::UniformRead,
-            )?,
-            mesh: Arc::new(MeshBuffers::upload(ctx, &scene.mesh)?),
-            albedo: upload_rgba8(ctx, "albedo", albedo)?,
-            normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
-            transfer: upload_buffer(
-                ctx,
-                "transfer",
-                bytemuck::cast_slice(
-                    &crate::light::occlusion::transfer_for(
-                        ctx,
-                        &scene.mesh,
-                        scene.file.skin.occlusion,
-                    )?
-                    .coeffs,
-                ),
-                Access::ShaderBufferRead,
-            )?,
-            specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
-            roughness: upload_rgba8(ctx, "roughness map", &scene.roughness)?,
-            variant: ShaderVariant {
-                lights: lights.len() as u32,
-                occlusion: scene.file.skin.occlusion != Occlusion::Off,
-                roughness_map: scene.file.textures.roughness.is_some(),
-                shadowed: bits(&|i| views[i].is_some()),
-                // Soft shadows where the map can take them: directional (linear depth).
-                soft: bits(&|i| {
-                    views[i].is_some()
-                        && lights[i].angular_radius > 0.0
-                        && matches!(lights[i].source, LightSource::Directional(_))
-                }),
-            },
-            lighting_env: if extraction.lights.is_empty() {
-                env.clone()
-            } else {
-                upload_env(ctx, &extraction.residual)?
-            },
-            env,
-            env_sampler: if ctx.supports_linear_filter(vk::Format::R32G32B32A32_SFLOAT) {
-                samplers.linear.clone()
-            } else {
-                samplers.nearest.clone()
-            },
-            samplers: samplers.clone(),
-        };
+        let m = &scene.mesh;
+        let specular_map = (scene.specular.width, scene.specular.height);
+        let specular_scale = 0.5
+            / specular::map_mean(
+                &m.positions,
+                &m.uvs,
+                &m.indices,
+                (specular_map.0, specular_map.1, &scene.specular.rgba8),
+            );
+        let uniforms = frame_uniforms(scene, &lighting, w as f32 / h as f32, specular_scale);
+        let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms)?;
+        let s = &inputs.samplers;
         let tables = SpecularTables::new(
             ctx,
             &skin.regions,
             &scene.regions,
-            samplers.linear.clone(),
-            samplers.nearest.clone(),
+            s.linear.clone(),
+            s.nearest.clone(),
         )?;
-        let res = skin.resolution;
-        let texels_per_mm = mean_stretch(&scene.mesh, res);
-        let constant_stretch = (!skin.stretch_correction).then_some(texels_per_mm);
-        let levels = chain::plan(&skin.profile, skin.chain, res, texels_per_mm);
+        let texels_per_mm = mean_stretch(&scene.mesh, skin.resolution);
+        let levels = chain::plan(&skin.profile, skin.chain, skin.resolution, texels_per_mm);
         log::info!(
-            "{:?} chain at {res}² ({texels_per_mm:.2} texels/mm): levels {:?}",
+            "{:?} chain at {}² ({texels_per_mm:.2} texels/mm): levels {levels:?}",
             skin.chain,
-            levels
+            skin.resolution
         );
-        let depth_range = depth_range(scene);
+        let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
+        let env = &scene.file.environment;
         Ok(Self {
             tables,
-            skybox: SkyboxPass::new(ctx)?,
-            direct: DirectPass::new(ctx, &inputs.variant)?,
-            stretch: StretchMaps::new(ctx, res, &skin.profile, constant_stretch)?,
-            irradiance: IrradiancePass::new(ctx, &inputs.variant)?,
-            blur: BlurChain::new(ctx, &skin.kernel, samplers.linear.clone())?,
-            shade: ShadePass::new(ctx, &inputs.variant)?,
-            shadow: ShadowPass::new(ctx, &views, shadow_res)?,
-            visibility: VisibilityPass::new(ctx, &inputs.variant, res)?,
-            views,
-            lights,
-            prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
-            debug: DebugPass::new(ctx, &scene.regions)?,
-            depth_range,
-            meter: Meter::new(ctx, samplers.nearest.clone())?,
-            glow: Glow::new(ctx, samplers.nearest.clone(), samplers.linear.clone())?,
-            tonemap: Tonemap::new(ctx, samplers.nearest.clone())?,
-            sh: ShPasses::new(ctx, samplers.nearest.clone())?,
-            sh_buffers: ShBuffers::new(
-                ctx,
-                &inputs.lighting_env,
-                scene.file.environment.rotation_deg,
-                scene.file.environment.intensity,
-            )?,
+            passes: Passes::new(ctx, scene, &inputs, &lighting, &skin, ruler)?,
+            sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, env.rotation_deg, env.intensity)?,
             inputs,
+            lighting,
+            weights: weights.try_into().unwrap_or([Vec3::ZERO; 6]),
             skin,
             levels,
-            ruler: if ruler {
-                Some(Ruler::new(ctx, samplers.nearest.clone())?)
-            } else {
-                None
-            },
+            specular_scale,
             skybox_on: scene.file.render.skybox,
+            depth_range: depth_range(scene),
             post: PostSettings::resolve(&scene.file.render),
-            extracted: extraction.lights,
         })
+    }
+
+    /// Bright sources taken out of the environment as lights.
+    pub(super) fn extracted_lights(&self) -> usize {
+        self.lighting.extracted.len()
     }
 
     /// Moves the camera to `scene.camera` at the aspect of `scene.file.render`'s
@@ -355,7 +338,8 @@ impl Frame {
     pub(super) fn set_camera(&mut self, ctx: &Arc<Context>, scene: &Scene) -> Result<()> {
         self.depth_range = depth_range(scene);
         let (w, h) = (scene.file.render.width, scene.file.render.height);
-        let uniforms = frame_uniforms(scene, &self.lights, w as f32 / h as f32, &self.views);
+        let aspect = w as f32 / h as f32;
+        let uniforms = frame_uniforms(scene, &self.lighting, aspect, self.specular_scale);
         self.inputs.uniforms = upload_buffer(
             ctx,
             "frame uniforms",
@@ -367,25 +351,14 @@ impl Frame {
 
     /// Turns the environment to `scene.file.environment.rotation_deg`: the SH
     /// transform, the extracted sources' directions, their shadow projections
-    /// and the uniforms are made again. What `kept` holds of them (the SH, the
-    /// shadows) is to be computed again.
-    pub(super) fn set_rotation(
-        &mut self,
-        ctx: &Arc<Context>,
-        scene: &Scene,
-        kept: &mut Kept,
-    ) -> Result<()> {
+    /// and the uniforms are made again; the SH and shadows, kept by key, are
+    /// computed again by the next frame that needs them.
+    pub(super) fn set_rotation(&mut self, ctx: &Arc<Context>, scene: &Scene) -> Result<()> {
         let env = &scene.file.environment;
-        self.sh_buffers = ShBuffers::new(
-            ctx,
-            &self.inputs.lighting_env,
-            env.rotation_deg,
-            env.intensity,
-        )?;
-        self.lights = frame_lights(scene, &self.extracted);
-        self.views = shadow_views(scene, &self.lights);
-        self.shadow.set_views(&self.views);
-        (kept.sh, kept.shadows) = (false, false);
+        self.lighting.turn(env.rotation_deg);
+        self.sh_buffers
+            .set_transform(ctx, env.rotation_deg, env.intensity)?;
+        self.passes.shadow.set_views(&self.lighting.views);
         self.set_camera(ctx, scene)
     }
 
@@ -396,16 +369,16 @@ impl Frame {
     }
 
     /// A UV-space view's image (stored values) encoded for display as the view
-    /// is shown (`render::view::Shown`).
-    pub(super) fn encode(&self, g: &mut Graph, image: ImageHandle, view: View) -> ImageHandle {
-        let images = self.post(g, view, image);
+    /// is shown.
+    pub(super) fn encode(&self, g: &mut Graph, image: ImageHandle, view: &View) -> ImageHandle {
+        let images = self.post(g, view.shown(), image);
         images.ldr.expect("post makes the 8-bit image")
     }
 
-    /// The exposure and display of `view` (render::view::Shown).
-    pub(super) fn display(&self, view: View) -> (Exposure, Display) {
+    /// The exposure and display of a view shown as `shown`.
+    pub(super) fn display(&self, shown: Shown) -> (Exposure, Display) {
         let display = self.post.display;
-        match view.shown() {
+        match shown {
             Shown::Exposed => (self.post.exposure, display),
             Shown::Fraction => (
                 Exposure::Given(0.0),
@@ -418,135 +391,136 @@ impl Frame {
         }
     }
 
-    /// Builds the frame graph for `view` at `(w, h)` (UV-space views: their
-    /// image as stored). What `kept` says is not yet computed, and the view
-    /// needs, the frame computes, and marks it computed.
+    /// Builds the frame graph for `view` at `size` (screen views; an image
+    /// view is the image as stored) and requests its images.
     pub(super) fn graph(
         &self,
         g: &mut Graph,
-        view: View,
-        (w, h): (u32, u32),
-        kept: &mut Kept,
-    ) -> FrameImages {
-        let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
-        let sh = self.sh.passes(
-            g,
-            &self.inputs.lighting_env,
-            &self.sh_buffers,
-            Access::UniformRead,
-            !std::mem::replace(&mut kept.sh, true),
-        );
-        let mut prefiltered = |g: &mut Graph| {
-            let first = !std::mem::replace(&mut kept.prefiltered, true);
-            self.prefilter.pass(g, &self.inputs.lighting_env, first)
-        };
-        if view == View::Prefiltered {
-            return FrameImages::uv(prefiltered(g));
+        view: &View,
+        size: (u32, u32),
+    ) -> Result<FrameImages> {
+        let light = self.lighting_images(g);
+        match view {
+            View::Screen(screen) => {
+                let hdr = self.screen(g, *screen, &light, size)?;
+                Ok(self.post(g, screen.shown(), hdr))
+            }
+            View::Image(name) => {
+                self.screen(g, Screen::Skin(ShadeMode::Full), &light, size)?;
+                let image = g
+                    .find_image(name)
+                    .filter(|i| i.desc.format == HDR_FORMAT)
+                    .ok_or_else(|| {
+                        Error::Input(format!(
+                            "--view {name}: no such view; `dermis render --view list` lists them"
+                        ))
+                    })?;
+                g.output(&image);
+                Ok(FrameImages::uv(image))
+            }
         }
-        let draw = !std::mem::replace(&mut kept.shadows, true);
-        let shadows = self.shadow.pass(g, &self.inputs.mesh, draw);
-        let soft = self.visibility.pass(g, &self.inputs, &shadows, draw);
-        let debug = match view {
-            View::Depth => Some(DebugView::Depth),
-            View::Normals => Some(DebugView::Normals),
-            View::Albedo => Some(DebugView::Albedo),
-            View::Regions => Some(DebugView::Regions),
-            _ => None,
-        };
-        if let Some(debug) = debug {
-            self.skybox.pass(g, &self.inputs, &mut hdr, false);
-            self.debug
-                .pass(g, debug, &self.inputs, self.depth_range, &mut hdr);
-        } else if let View::Direct | View::Occlusion = view {
-            let direct = match view {
-                View::Direct => DirectView::Shading,
-                _ => DirectView::Occlusion,
-            };
-            self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
-            self.direct
-                .pass(g, direct, &self.inputs, &sh, &shadows, &soft, &mut hdr);
-        } else {
-            let res = self.skin.resolution;
-            let mesh = &self.inputs.mesh;
-            let first = !std::mem::replace(&mut kept.stretch, true);
-            let mut stretch = self.stretch.pass(g, mesh, &self.blur, first);
-            let irradiance = self.irradiance.pass(
-                g,
-                &self.inputs,
-                &self.tables,
-                &sh,
-                (&shadows, &soft),
-                res,
-                self.skin.mix,
-            );
-            if let View::Stretch(k) = view {
-                return FrameImages::uv(stretch.swap_remove(k as usize));
-            }
-            if view == View::Irradiance {
-                return FrameImages::uv(irradiance);
-            }
-            if let Some(r) = &self.ruler {
-                r.passes(g, &irradiance);
-            }
-            let mut blurred = self.blur.chain(g, &irradiance, &stretch, &self.levels);
-            if let View::Blur(k) = view {
-                // Level k is the last blur at or before it, or the irradiance.
-                let made = self.levels[..k as usize]
-                    .iter()
-                    .filter(|l| l.sigma_mm.is_some())
-                    .count();
-                return FrameImages::uv(match made {
-                    0 => irradiance,
-                    n => blurred.swap_remove(n - 1),
-                });
-            }
-            let specular_env = prefiltered(g);
-            self.skybox.pass(g, &self.inputs, &mut hdr, self.skybox_on);
-            let weights: Vec<_> = self
-                .skin
-                .profile
-                .gaussians
-                .iter()
-                .map(|g| g.weights)
-                .collect();
-            let weights: [glam::Vec3; 6] = weights.try_into().unwrap_or([glam::Vec3::ZERO; 6]);
-            let mode = match view {
-                View::Diffuse => ShadeMode::Diffuse,
-                View::Specular => ShadeMode::Specular,
-                _ => ShadeMode::Full,
-            };
-            let settings = ShadeSettings {
-                weights,
-                mix: self.skin.mix,
-                blur_amount: self.skin.blur_amount,
-                mode,
-            };
-            self.shade.pass(
-                g,
-                &self.inputs,
-                &self.tables,
-                ShadeImages {
-                    irradiance: &irradiance,
-                    levels: &BlurChain::select(&irradiance, &blurred, &self.levels),
-                    shadows: &shadows,
-                    soft_visibility: &soft,
-                    specular_env: &specular_env,
-                },
-                settings,
-                &mut hdr,
-            );
-        }
-        self.post(g, view, hdr)
     }
 
-    /// Metering, glow and tone mapping of a screen view's `hdr`.
-    fn post(&self, g: &mut Graph, view: View, hdr: ImageHandle) -> FrameImages {
-        let (exposure, display) = self.display(view);
-        let exposed = view.shown() == Shown::Exposed;
+    /// The names of every view of the frame: the screen views, then the
+    /// frame graph's images that can be read back as stored.
+    pub(super) fn views(&self, size: (u32, u32)) -> Result<Vec<String>> {
+        let mut g = Graph::new();
+        let light = self.lighting_images(&mut g);
+        self.screen(&mut g, Screen::Skin(ShadeMode::Full), &light, size)?;
+        let images = g
+            .image_names()
+            .into_iter()
+            .filter(|n| g.find_image(n).is_some_and(|i| i.desc.format == HDR_FORMAT));
+        let screens = Screen::all().map(|s| s.name().to_string());
+        Ok(screens.chain(images).collect())
+    }
+
+    /// The SH coefficients, the shadow atlas and the soft lights' visibility,
+    /// each kept by the key of its inputs.
+    fn lighting_images(&self, g: &mut Graph) -> LightImages {
+        let p = &self.passes;
+        let sh = p.sh.passes(g, &self.inputs.lighting_env, &self.sh_buffers);
+        let key = self.lighting.shadow_key();
+        let shadows = p.shadow.pass(g, &self.inputs.mesh, key);
+        let soft = p.visibility.pass(g, &self.inputs, &shadows, key);
+        LightImages { sh, shadows, soft }
+    }
+
+    /// The screen image (HDR) of `screen` at `(w, h)`.
+    fn screen(
+        &self,
+        g: &mut Graph,
+        screen: Screen,
+        light: &LightImages,
+        (w, h): (u32, u32),
+    ) -> Result<ImageHandle> {
+        let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
+        let (p, inputs) = (&self.passes, &self.inputs);
+        match screen {
+            Screen::Skin(mode) => self.skin(g, mode, light, &mut hdr),
+            // The frame was made with the checker as its albedo.
+            Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr),
+            Screen::Direct(view) => {
+                p.skybox.pass(g, inputs, &mut hdr, self.skybox_on);
+                let (sh, shadows, soft) = (&light.sh, &light.shadows, &light.soft);
+                p.direct.pass(g, view, inputs, sh, shadows, soft, &mut hdr);
+            }
+            Screen::Debug(view) => {
+                p.skybox.pass(g, inputs, &mut hdr, false);
+                p.debug.pass(g, view, inputs, self.depth_range, &mut hdr);
+            }
+            Screen::Reference => {
+                return Err(Error::Input(
+                    "the reference view is rendered on the CPU, not by the frame graph".into(),
+                ))
+            }
+        }
+        Ok(hdr)
+    }
+
+    /// Texture-space diffusion and the skin pass in `mode`, into `hdr`.
+    fn skin(&self, g: &mut Graph, mode: ShadeMode, light: &LightImages, hdr: &mut ImageHandle) {
+        let (p, inputs) = (&self.passes, &self.inputs);
+        let stretch = p.stretch.pass(g, &inputs.mesh, &p.blur);
+        let irradiance = p.irradiance.pass(
+            g,
+            inputs,
+            &self.tables,
+            &light.sh,
+            (&light.shadows, &light.soft),
+            self.skin.resolution,
+            self.skin.mix,
+        );
+        if let Some(r) = &p.ruler {
+            r.passes(g, &irradiance);
+        }
+        let blurred = p.blur.chain(g, &irradiance, &stretch, &self.levels);
+        let specular_env = p.prefilter.pass(g, &inputs.lighting_env);
+        p.skybox.pass(g, inputs, hdr, self.skybox_on);
+        let settings = ShadeSettings {
+            weights: self.weights,
+            mix: self.skin.mix,
+            blur_amount: self.skin.blur_amount,
+            mode,
+        };
+        let images = ShadeImages {
+            irradiance: &irradiance,
+            levels: &BlurChain::select(&irradiance, &blurred, &self.levels),
+            shadows: &light.shadows,
+            soft_visibility: &light.soft,
+            specular_env: &specular_env,
+        };
+        p.shade.pass(g, inputs, &self.tables, images, settings, hdr);
+    }
+
+    /// Metering, glow and tone mapping of a screen image `hdr` shown as `shown`.
+    fn post(&self, g: &mut Graph, shown: Shown, hdr: ImageHandle) -> FrameImages {
+        let (exposure, display) = self.display(shown);
+        let p = &self.passes;
         // Metered before the glow: the exposure is the skin's.
-        let metered = (exposure == Exposure::Metered).then(|| self.meter.pass(g, &hdr));
+        let metered = (exposure == Exposure::Metered).then(|| p.meter.pass(g, &hdr));
         let hdr = match self.post.glow {
-            Some(intensity) if exposed => self.glow.pass(g, &hdr, intensity),
+            Some(intensity) if shown == Shown::Exposed => p.glow.pass(g, &hdr, intensity),
             _ => hdr,
         };
         let (w, h) = (hdr.desc.width, hdr.desc.height);
@@ -555,12 +529,13 @@ impl Frame {
         let result = match &metered {
             Some(m) => m,
             None => {
-                unwritten = self.meter.result(g);
+                unwritten = p.meter.result(g);
                 &unwritten
             }
         };
-        self.tonemap
+        p.tonemap
             .pass(g, &hdr, result, &mut ldr, exposure, &display);
+        g.output(&ldr);
         FrameImages {
             image: hdr,
             ldr: Some(ldr),
@@ -569,24 +544,9 @@ impl Frame {
     }
 }
 
-/// What a render computes once and keeps between its frames (the scene, the
-/// lights and the mesh do not change within it): each is computed by the first
-/// frame whose view needs it.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Kept {
-    /// The environment's SH coefficients (light::sh_pass).
-    sh: bool,
-    /// The KS-prefiltered environment (light::prefilter).
-    prefiltered: bool,
-    /// The shadow atlas and the soft lights' visibility (light::shadow, light::visibility).
-    shadows: bool,
-    /// The stretch maps (skin::stretch).
-    stretch: bool,
-}
-
 /// The images a frame graph ends with.
 pub(super) struct FrameImages {
-    /// A screen view's HDR image as tone-mapped (after the glow), or a UV-space
+    /// A screen view's HDR image as tone-mapped (after the glow), or an image
     /// view's image as stored.
     pub image: ImageHandle,
     /// A screen view's 8-bit image.

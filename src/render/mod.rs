@@ -10,12 +10,12 @@ pub mod session;
 pub mod sheet;
 mod view;
 
-pub use view::{Shown, View};
+pub use view::{Screen, Shown, View};
 
 use crate::error::{Error, Result};
 use crate::gpu::{Context, DeviceInfo};
 use crate::graph::upload::Readback;
-use crate::graph::{Executor, Graph};
+use crate::graph::{Executor, Graph, Kept};
 use crate::light::reference::{render_view, ReferenceImage, Settings as ReferenceSettings};
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
@@ -26,7 +26,7 @@ use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
-use frame::{Frame, Kept};
+use frame::Frame;
 use progress::Progress;
 use sheet::Sheet;
 use std::path::PathBuf;
@@ -73,7 +73,7 @@ impl Default for RenderOptions {
         Self {
             frames: 1,
             hdr: false,
-            view: View::Final,
+            view: View::FINAL,
             scene_path: None,
             progress: false,
             ruler: false,
@@ -88,7 +88,7 @@ impl Default for RenderOptions {
 fn setup(
     scene: &Scene,
     opts: &RenderOptions,
-    view: View,
+    view: &View,
     extracted_lights: usize,
     (exposure_ev, exposure_metered): (f32, bool),
 ) -> RunSetup {
@@ -136,7 +136,7 @@ fn setup(
         },
         blur_width: f.skin.blur_width,
         blur_amount: f.skin.blur_amount,
-        test_texture: f.textures.test_texture || view == View::TestTexture,
+        test_texture: f.textures.test_texture || *view == View::Screen(Screen::TestTexture),
         gamma: match f.render.gamma {
             Gamma::Srgb => "srgb".into(),
             Gamma::Power(g) => g.to_string(),
@@ -210,11 +210,12 @@ pub fn render_scene(
     }
     let warmup = opts.warmup_frames()?;
     let skin = settings(ctx, scene)?;
-    if opts.view == View::Reference {
+    if opts.view == View::Screen(Screen::Reference) {
         return reference(ctx, scene, opts);
     }
     let test_texture;
-    let albedo = if opts.view == View::TestTexture && !scene.file.textures.test_texture {
+    let checker = opts.view == View::Screen(Screen::TestTexture);
+    let albedo = if checker && !scene.file.textures.test_texture {
         test_texture = checker::albedo(scene.file.textures.uv_origin);
         &test_texture
     } else {
@@ -224,7 +225,7 @@ pub fn render_scene(
     let mut last = None;
     for run_index in 0..opts.runs {
         let frame = Frame::new(ctx, scene, albedo, skin.clone(), opts.ruler)?;
-        let out = run(ctx, scene, &frame, opts.view, opts)?;
+        let out = run(ctx, scene, &frame, &opts.view, opts)?;
         frames.extend(out.report.per_frame.iter().cloned().map(|mut f| {
             f.run = run_index;
             f
@@ -253,30 +254,34 @@ fn settings(ctx: &Arc<Context>, scene: &Scene) -> Result<SkinSettings> {
 }
 
 /// The views of the debug sheet (the paper's Fig. 3 and debug mode), in rows
-/// of [`sheet::COLUMNS`]: the stretch levels, the blur levels, then depth,
-/// occlusion and specular.
-pub const SHEET_VIEWS: [View; 15] = [
-    View::Stretch(0),
-    View::Stretch(1),
-    View::Stretch(2),
-    View::Stretch(3),
-    View::Stretch(4),
-    View::Stretch(5),
-    View::Blur(1),
-    View::Blur(2),
-    View::Blur(3),
-    View::Blur(4),
-    View::Blur(5),
-    View::Blur(6),
-    View::Depth,
-    View::Occlusion,
-    View::Specular,
-];
+/// of [`sheet::COLUMNS`]: the six stretch levels, the six blur levels, then
+/// depth, occlusion and specular.
+pub fn sheet_views() -> Vec<View> {
+    let stretch = (0..6).map(crate::skin::stretch::level_name);
+    let blur = (1..=6).map(crate::skin::blur::BlurChain::level_name);
+    let screens = [
+        Screen::Debug(crate::post::debug::DebugView::Depth),
+        Screen::Direct(crate::light::direct::DirectView::Occlusion),
+        Screen::Skin(crate::skin::shade::ShadeMode::Specular),
+    ];
+    stretch
+        .chain(blur)
+        .map(View::Image)
+        .chain(screens.map(View::Screen))
+        .collect()
+}
+
+/// Every view of `scene` (`render --view list`): the screen views, then the
+/// frame graph's images that can be read back as stored.
+pub fn views(ctx: &Arc<Context>, scene: &Scene) -> Result<Vec<String>> {
+    let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
+    frame.views((scene.file.render.width, scene.file.render.height))
+}
 
 /// Whether `view` is shown upside down from how it is stored: UV-space views are
 /// shown in the orientation of the scene's maps, and maps with their UV origin
 /// at the bottom left were flipped on load (scene::texture::flip_rows).
-fn flipped(scene: &Scene, view: View) -> bool {
+fn flipped(scene: &Scene, view: &View) -> bool {
     view.uv_space() && scene.file.textures.uv_origin == UvOrigin::BottomLeft
 }
 
@@ -294,9 +299,9 @@ fn single(opts: &RenderOptions) -> RenderOptions {
 /// one upload of the scene) and labelled with its name.
 pub fn debug_sheet(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<Sheet> {
     let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
-    let tiles = SHEET_VIEWS
+    let tiles = sheet_views()
         .iter()
-        .map(|&view| {
+        .map(|view| {
             let out = run(ctx, scene, &frame, view, &single(opts))?;
             Ok((view.name().to_string(), out))
         })
@@ -332,13 +337,13 @@ fn run(
     ctx: &Arc<Context>,
     scene: &Scene,
     frame: &Frame,
-    view: View,
+    view: &View,
     opts: &RenderOptions,
 ) -> Result<RenderOutput> {
     let screen = (scene.file.render.width, scene.file.render.height);
     // The view's image and its size (UV views: as stored, e.g. a coarse adaptive level).
     let (w, h) = {
-        let images = frame.graph(&mut Graph::new(), view, screen, &mut Kept::default());
+        let images = frame.graph(&mut Graph::new(), view, screen)?;
         (images.image.desc.width, images.image.desc.height)
     };
     let readback = |name: &str, bytes_per_texel: u64| {
@@ -362,10 +367,11 @@ fn run(
     let mut plan = String::new();
     let mut gpu_metered = false;
     let progress = Progress::new(opts.frames, opts.progress);
+    // What the frames compute once and keep (SH, shadows, stretch maps …).
     let mut kept = Kept::default();
     for _ in 0..opts.frames {
-        let mut g = Graph::new();
-        let images = frame.graph(&mut g, view, screen, &mut kept);
+        let mut g = Graph::with_kept(kept.clone());
+        let images = frame.graph(&mut g, view, screen)?;
         if let (Some(ldr), Some(r)) = (&images.ldr, &ldr_readback) {
             r.image_pass(&mut g, ldr);
         }
@@ -378,6 +384,7 @@ fn run(
             r.image_pass(&mut g, &images.image);
         }
         let compiled = executor.compile(g)?;
+        kept = compiled.plan.kept.clone();
         plan = compiled.plan.to_string();
         reports.extend(executor.submit(compiled)?);
         progress.update(reports.len(), reports.last().and_then(|r| r.gpu_frame_ns));
@@ -393,7 +400,7 @@ fn run(
         ),
         None => None,
     };
-    let (exposure, display) = frame.display(view);
+    let (exposure, display) = frame.display(view.shown());
     let metered = match (exposure, &hdr) {
         _ if gpu_metered => Some(Metered::from_bytes(exposure_readback.bytes()?)),
         // UV-space views are metered here, on the CPU.
@@ -425,7 +432,7 @@ fn run(
         scene,
         opts,
         view,
-        frame.extracted.len(),
+        frame.extracted_lights(),
         (ev, metered.is_some()),
     );
     let warmup = opts.warmup_frames()? as usize;
@@ -433,7 +440,7 @@ fn run(
     Ok(RenderOutput {
         width: w,
         height: h,
-        view,
+        view: view.clone(),
         reference: None,
         rgba8,
         hdr,
@@ -459,11 +466,12 @@ fn reference(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<
     let rgba8 = encode8(&image.rgba, ev, &post.display);
     let rgba = std::mem::take(&mut image.rgba);
     let hdr = opts.hdr.then_some(rgba);
-    let setup = setup(scene, opts, View::Reference, 0, (ev, metered.is_some()));
+    let view = View::Screen(Screen::Reference);
+    let setup = setup(scene, opts, &view, 0, (ev, metered.is_some()));
     Ok(RenderOutput {
         width: w,
         height: h,
-        view: View::Reference,
+        view,
         reference: Some(image),
         rgba8,
         hdr,

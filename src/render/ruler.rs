@@ -10,6 +10,9 @@ use crate::graph::{Graph, ImageHandle};
 use crate::profile::RULER_COPY;
 use std::sync::Arc;
 
+/// The tag of the ruler passes.
+pub const TAG: &str = "ruler";
+
 pub struct Ruler {
     copy: Arc<Pipeline>,
     read: Arc<Pipeline>,
@@ -30,13 +33,18 @@ impl Ruler {
         let desc = src.desc;
         let mut copy = g.create_image("ruler copy", desc);
         g.simple_pass(RULER_COPY, &self.copy)
+            .tag(TAG)
             .sample(src, &self.sampler)
             .store(&mut copy)
             .dispatch([desc.width, desc.height, 1]);
         let mut sink = g.create_image("ruler sink", ImageDesc::new(1, 1, desc.format));
         g.simple_pass("ruler_read", &self.read)
+            .tag(TAG)
             .sample(src, &self.sampler)
             .store(&mut sink)
             .dispatch([desc.width, desc.height, 1]);
+        // Timed, not read: requested, so that the graph keeps them.
+        g.output(&copy);
+        g.output(&sink);
     }
 }

@@ -4,11 +4,11 @@
 //! only makes the frame's uniforms again, turning the environment also its SH
 //! and the lights' shadows; anything else is a new session.
 
-use super::frame::{Frame, Kept};
+use super::frame::Frame;
 use super::{check_target, settings, View};
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc};
-use crate::graph::{Access, Executor, Graph, Imported};
+use crate::graph::{Access, Executor, Graph, Imported, Kept};
 use crate::post::PostSettings;
 use crate::profile::FrameReport;
 use crate::scene::camera::Camera;
@@ -24,6 +24,8 @@ pub struct Session {
     /// What the session's frames have computed and keep (stretch maps, SH,
     /// the prefiltered environment, shadows).
     kept: Kept,
+    /// Every view of the session's frame (`render --view list`).
+    views: Vec<String>,
 }
 
 impl Session {
@@ -34,7 +36,9 @@ impl Session {
         // Its passes wait for a window frame in progress (gpu::Context::foreground).
         let mut executor = Executor::new(ctx, 1)?;
         executor.set_background();
+        let size = (scene.file.render.width, scene.file.render.height);
         Ok(Self {
+            views: frame.views(size)?,
             ctx: ctx.clone(),
             executor,
             scene,
@@ -43,13 +47,19 @@ impl Session {
         })
     }
 
+    /// Every view the session can render: the screen views, then the frame
+    /// graph's images.
+    pub fn views(&self) -> &[String] {
+        &self.views
+    }
+
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
     /// Bright sources the session's frames light with (`environment.lights`).
     pub fn extracted_lights(&self) -> usize {
-        self.frame.extracted.len()
+        self.frame.extracted_lights()
     }
 
     /// Turns the environment (`environment.rotation_deg`) without a new session:
@@ -59,8 +69,7 @@ impl Session {
             return Ok(());
         }
         self.scene.file.environment.rotation_deg = rotation_deg;
-        self.frame
-            .set_rotation(&self.ctx, &self.scene, &mut self.kept)
+        self.frame.set_rotation(&self.ctx, &self.scene)
     }
 
     /// Replaces the post-processing settings (`render`'s exposure, tone curve,
@@ -81,12 +90,10 @@ impl Session {
     /// Renders `view` once and waits for it: the displayable image (RGBA8,
     /// sRGB-encoded, left in SHADER_READ_ONLY_OPTIMAL for fragment sampling)
     /// and the frame's report.
-    pub fn render(&mut self, view: View) -> Result<(Arc<Image>, Option<FrameReport>)> {
+    pub fn render(&mut self, view: &View) -> Result<(Arc<Image>, Option<FrameReport>)> {
         let size = (self.scene.file.render.width, self.scene.file.render.height);
-        let mut g = Graph::new();
-        // Marked kept once the frame has been submitted.
-        let mut kept = self.kept;
-        let images = self.frame.graph(&mut g, view, size, &mut kept);
+        let mut g = Graph::with_kept(self.kept.clone());
+        let images = self.frame.graph(&mut g, view, size)?;
         let ldr = match images.ldr {
             Some(ldr) => ldr,
             None => self.frame.encode(&mut g, images.image, view),
@@ -119,6 +126,8 @@ impl Session {
             false => cx.copy_image(src, dst),
         });
         let compiled = self.executor.compile(g)?;
+        // Kept once the frame has been submitted.
+        let kept = compiled.plan.kept.clone();
         let mut reports = self
             .executor
             .submit(compiled)?

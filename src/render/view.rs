@@ -1,152 +1,130 @@
-//! What a render writes: the final image or one intermediate (the paper's debug
-//! views).
+//! What a render writes: a screen view, which has shading of its own (the final
+//! image, its terms, the debug views), or any image of the frame graph by name
+//! (the paper's debug views of the intermediates: irradiance, stretch and blur
+//! levels, the prefiltered environment …), read back as stored.
 
 use crate::error::{Error, Result};
+use crate::light::direct::DirectView;
+use crate::post::debug::DebugView;
+pub use crate::post::Shown;
+use crate::skin::shade::ShadeMode;
 
-/// What `render` writes: the final image or one intermediate.
+/// A view with shading of its own: the pass that writes its screen image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum View {
-    /// The final image: texture-space diffusion and specular.
-    Final,
-    /// The diffuse (subsurface) term alone.
-    Diffuse,
-    /// The Kelemen/Szirmay-Kalos specular term alone (the paper's Fig. 1).
-    Specular,
-    /// Direct diffuse shading in screen space, no scattering (for comparison).
-    Direct,
-    /// The same quantity integrated on the CPU by Monte Carlo against the full
-    /// environment map with ray-cast visibility (light::reference): slow, offline.
-    Reference,
-    /// The per-vertex transfer's DC term relative to open sky (1 = unoccluded).
-    Occlusion,
-    /// Linear depth over the mesh's bounding sphere (post::debug).
-    Depth,
-    /// The shading normal after the normal map, world space, 0.5·n + 0.5.
-    Normals,
-    /// The albedo map on the mesh.
-    Albedo,
-    /// The face-region ids in distinct colours.
-    Regions,
+pub enum Screen {
+    /// The skin pass: the final image, or its diffuse or specular term alone.
+    Skin(ShadeMode),
+    /// Direct diffuse shading in screen space (no scattering), or the
+    /// per-vertex occlusion relative to open sky.
+    Direct(DirectView),
+    /// Depth, normals, albedo, regions (post::debug).
+    Debug(DebugView),
     /// The final image with the numbered UV checker as the albedo (scene::checker).
     TestTexture,
-    /// UV-space irradiance (coverage-premultiplied, as stored).
-    Irradiance,
-    /// UV-space stretch level 0 (unblurred) ..= 5 (texels per mm in R and G;
-    /// alpha = coverage).
-    Stretch(u8),
-    /// UV-space blur level 1..=6 (as stored).
-    Blur(u8),
-    /// The KS-prefiltered environment: its roughness levels stacked top to bottom
-    /// (light::prefilter).
-    Prefiltered,
+    /// The direct term integrated on the CPU by Monte Carlo against the full
+    /// environment map with ray-cast visibility (light::reference): slow, offline.
+    Reference,
 }
 
-/// How a view's image becomes display values (render/: post::Display).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Shown {
-    /// Radiance: glow, the exposure (given or metered), the scene's tone curve
-    /// and transfer function.
-    Exposed,
-    /// A fraction in [0, 1] (occlusion, albedo): exposure 0, no curve, the
-    /// scene's transfer function.
-    Fraction,
-    /// Data (depth, normals, region colours): the values as they are.
-    Data,
-}
+impl Screen {
+    /// Every screen view, in the order `--view list` prints them.
+    pub fn all() -> impl Iterator<Item = Screen> {
+        ShadeMode::ALL
+            .map(Screen::Skin)
+            .into_iter()
+            .chain(DirectView::ALL.map(Screen::Direct))
+            .chain([Screen::Reference])
+            .chain(DebugView::ALL.map(Screen::Debug))
+            .chain([Screen::TestTexture])
+    }
 
-const STRETCH: [&str; 6] = [
-    "stretch", "stretch1", "stretch2", "stretch3", "stretch4", "stretch5",
-];
-const BLUR: [&str; 6] = ["blur1", "blur2", "blur3", "blur4", "blur5", "blur6"];
-
-impl View {
-    /// Every view, in the order `--help` lists them.
-    pub const ALL: [View; 25] = [
-        View::Final,
-        View::Diffuse,
-        View::Specular,
-        View::Direct,
-        View::Reference,
-        View::Occlusion,
-        View::Depth,
-        View::Normals,
-        View::Albedo,
-        View::Regions,
-        View::TestTexture,
-        View::Irradiance,
-        View::Stretch(0),
-        View::Stretch(1),
-        View::Stretch(2),
-        View::Stretch(3),
-        View::Stretch(4),
-        View::Stretch(5),
-        View::Blur(1),
-        View::Blur(2),
-        View::Blur(3),
-        View::Blur(4),
-        View::Blur(5),
-        View::Blur(6),
-        View::Prefiltered,
-    ];
-
-    /// The command-line name: `final`, …, `stretch`, `stretch1`…`stretch5`,
-    /// `blur1`…`blur6`, `prefiltered`.
     pub fn name(self) -> &'static str {
         match self {
-            View::Final => "final",
-            View::Diffuse => "diffuse",
-            View::Specular => "specular",
-            View::Direct => "direct",
-            View::Reference => "reference",
-            View::Occlusion => "occlusion",
-            View::Depth => "depth",
-            View::Normals => "normals",
-            View::Albedo => "albedo",
-            View::Regions => "regions",
-            View::TestTexture => "test-texture",
-            View::Irradiance => "irradiance",
-            View::Stretch(k) => STRETCH[k.min(5) as usize],
-            View::Blur(k) => BLUR[(k.clamp(1, 6) - 1) as usize],
-            View::Prefiltered => "prefiltered",
+            Screen::Skin(mode) => mode.name(),
+            Screen::Direct(view) => view.name(),
+            Screen::Debug(view) => view.name(),
+            Screen::TestTexture => "test-texture",
+            Screen::Reference => "reference",
         }
-    }
-
-    pub fn parse(s: &str) -> Result<View> {
-        Self::ALL
-            .into_iter()
-            .find(|v| v.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = Self::ALL.iter().map(|v| v.name()).collect();
-                Error::Input(format!("unknown view {s:?}: {}", names.join(", ")))
-            })
-    }
-
-    /// Whether the view is an intermediate texture rather than a screen image:
-    /// read back as stored, without tone mapping.
-    pub fn uv_space(self) -> bool {
-        matches!(
-            self,
-            View::Irradiance | View::Stretch(_) | View::Blur(_) | View::Prefiltered
-        )
     }
 
     /// How the view is shown.
     pub fn shown(self) -> Shown {
         match self {
-            View::Occlusion | View::Albedo => Shown::Fraction,
-            View::Depth | View::Normals | View::Regions => Shown::Data,
-            _ => Shown::Exposed,
+            Screen::Skin(_)
+            | Screen::TestTexture
+            | Screen::Reference
+            | Screen::Direct(DirectView::Shading) => Shown::Exposed,
+            Screen::Direct(DirectView::Occlusion) => Shown::Fraction,
+            Screen::Debug(view) => view.shown(),
         }
     }
 }
 
-impl clap::ValueEnum for View {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Self::ALL
+/// What `render` writes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum View {
+    Screen(Screen),
+    /// An image of the frame graph by name (`render --view list`), read back
+    /// as stored, without tone mapping: the UV-space intermediates.
+    Image(String),
+}
+
+impl View {
+    /// The final image: texture-space diffusion and specular.
+    pub const FINAL: View = View::Screen(Screen::Skin(ShadeMode::Full));
+
+    /// The screen view named `name`, else the graph image of that name (the
+    /// frame checks that it has one).
+    pub fn named(name: &str) -> View {
+        Screen::all()
+            .find(|s| s.name() == name)
+            .map_or_else(|| View::Image(name.into()), View::Screen)
     }
 
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()))
+    /// `--view NAME`: [`View::named`], for a name that can be one.
+    pub fn parse(name: &str) -> Result<View> {
+        if name.trim().is_empty() {
+            return Err(Error::Input(
+                "--view: empty; `dermis render --view list` lists the views".into(),
+            ));
+        }
+        Ok(View::named(name))
+    }
+
+    pub fn name(&self) -> &str {
+        match self {
+            View::Screen(s) => s.name(),
+            View::Image(name) => name,
+        }
+    }
+
+    /// Whether the view is an intermediate image rather than a screen image:
+    /// read back as stored, without tone mapping.
+    pub fn uv_space(&self) -> bool {
+        matches!(self, View::Image(_))
+    }
+
+    /// How the view is shown (an image as stored is exposed like radiance).
+    pub fn shown(&self) -> Shown {
+        match self {
+            View::Screen(s) => s.shown(),
+            View::Image(_) => Shown::Exposed,
+        }
+    }
+}
+
+impl std::str::FromStr for View {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<View> {
+        View::parse(s)
+    }
+}
+
+impl std::fmt::Display for View {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -156,14 +134,14 @@ mod tests {
 
     #[test]
     fn names_round_trip() {
-        for v in View::ALL {
-            assert_eq!(View::parse(v.name()).unwrap(), v);
+        let names: Vec<_> = Screen::all().map(Screen::name).collect();
+        assert_eq!(names.len(), 11, "{names:?}");
+        for s in Screen::all() {
+            assert_eq!(View::parse(s.name()).unwrap(), View::Screen(s));
         }
-        assert_eq!(View::parse("blur4").unwrap(), View::Blur(4));
-        assert_eq!(View::parse("stretch").unwrap(), View::Stretch(0));
-        assert_eq!(View::parse("stretch5").unwrap(), View::Stretch(5));
-        let e = View::parse("blur7").unwrap_err().to_string();
-        assert!(e.contains("blur6") && e.contains("prefiltered"), "{e}");
-        assert!(View::parse("stretch6").is_err());
+        assert_eq!(View::parse("blur4").unwrap(), View::Image("blur4".into()));
+        assert_eq!(View::parse("final").unwrap(), View::FINAL);
+        assert!(View::parse(" ").is_err());
+        assert!(View::named("irradiance").uv_space() && !View::FINAL.uv_space());
     }
 }

@@ -87,10 +87,12 @@ impl BlurChain {
     ) -> Vec<ImageHandle> {
         let mut out: Vec<ImageHandle> = Vec::new();
         for (k, level) in levels.iter().enumerate() {
+            let name = Self::level_name(k + 1);
             let Some(sigma) = level.sigma_mm else {
+                // The level is its predecessor's image.
+                g.alias(&name, out.last().unwrap_or(irradiance));
                 continue;
             };
-            let name = format!("blur{}", k + 1);
             let desc = ImageDesc::new(level.resolution, level.resolution, UV_FORMAT);
             let mut dst = g.create_image(&name, desc);
             let src = out.last().unwrap_or(irradiance);
@@ -98,6 +100,11 @@ impl BlurChain {
             out.push(dst);
         }
         out
+    }
+
+    /// The name of blur level `k` (1..=6; a view's name).
+    pub fn level_name(k: usize) -> String {
+        format!("blur{k}")
     }
 
     /// The image of each of the six levels: the level's own blur, or for a
@@ -148,6 +155,7 @@ impl BlurChain {
     ) {
         let (w, h) = (dst.desc.width, dst.desc.height);
         g.simple_pass(name, &self.pipeline)
+            .tag(super::TAG)
             .sample(src, &self.sampler)
             .sample(stretch, &self.sampler)
             .store(dst)

@@ -26,6 +26,10 @@ use std::sync::Arc;
 /// coverage-premultiplied RGBA16F, as the design card fixes for the 4096² chain.
 pub const UV_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
+/// The tag of the diffusion chain's passes: the stretch levels and the blurs
+/// (what `dermis sweep` sums as the chain).
+pub const TAG: &str = "diffusion";
+
 /// Settings of the skin model, resolved once from the scene's `[skin]` and
 /// `[render]`: defaults filled in, checked against what the passes support.
 #[derive(Clone, Debug)]

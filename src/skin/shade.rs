@@ -54,6 +54,19 @@ pub enum ShadeMode {
     Specular = 2,
 }
 
+impl ShadeMode {
+    pub const ALL: [ShadeMode; 3] = [ShadeMode::Full, ShadeMode::Diffuse, ShadeMode::Specular];
+
+    /// The view's name (`render --view`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadeMode::Full => "final",
+            ShadeMode::Diffuse => "diffuse",
+            ShadeMode::Specular => "specular",
+        }
+    }
+}
+
 pub struct ShadePass {
     /// Depth only: the pre-pass (scanned heads are two-sided and not consistently
     /// wound, so back faces are not culled; without it their fragments are shaded

@@ -60,42 +60,49 @@ impl StretchMaps {
         })
     }
 
-    /// The stretch levels 0..=5 as graph images; `first`: the render's first
-    /// frame, which computes them (passes `stretch` and `stretch{k}_u/_v`).
-    pub fn pass(
-        &self,
-        g: &mut Graph,
-        mesh: &MeshBuffers,
-        blur: &BlurChain,
-        first: bool,
-    ) -> Vec<ImageHandle> {
-        let initial = (!first).then_some(Access::ShaderSampled);
+    /// The stretch levels 0..=5 as graph images, kept: the mesh is rigid for
+    /// a render, so the first frame that needs them computes them (passes
+    /// `stretch` and `stretch{k}_u/_v`).
+    pub fn pass(&self, g: &mut Graph, mesh: &MeshBuffers, blur: &BlurChain) -> Vec<ImageHandle> {
+        let mut first = false;
         let mut out: Vec<ImageHandle> = self
             .levels
             .iter()
             .enumerate()
             .map(|(k, image)| {
-                g.import_image(
-                    &format!("stretch{k}"),
+                let (level, stale) = g.import_kept_image(
+                    &level_name(k),
                     Imported::Image(image.clone()),
-                    initial,
-                    Some(Access::ShaderSampled),
-                )
+                    Access::ShaderSampled,
+                    0,
+                );
+                first |= stale;
+                level
             })
             .collect();
         if first {
             let constant = self.constant.map_or(0.0, |c| c / self.scale);
             let pass = g
                 .simple_pass("stretch", &self.pipeline)
+                .tag(super::TAG)
                 .color(&mut out[0], LoadOp::Clear([0.0; 4]))
                 .constants(&constant);
             mesh.draw(pass);
             for (k, &sigma) in self.increments.iter().enumerate() {
                 let (done, rest) = out.split_at_mut(k + 1);
-                let name = format!("stretch{}", k + 1);
+                let name = level_name(k + 1);
                 blur.gaussian(g, &name, &done[k], &done[k], sigma, &mut rest[0]);
             }
         }
         out
+    }
+}
+
+/// The name of stretch level `k` (a view's name): `stretch` (unblurred),
+/// `stretch1`…`stretch5`.
+pub fn level_name(k: usize) -> String {
+    match k {
+        0 => "stretch".into(),
+        k => format!("stretch{k}"),
     }
 }

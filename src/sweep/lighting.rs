@@ -88,7 +88,7 @@ pub fn run(
                 ctx,
                 &scene,
                 &RenderOptions {
-                    view: View::Direct,
+                    view: View::named("direct"),
                     hdr: true,
                     ..RenderOptions::default()
                 },

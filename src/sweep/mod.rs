@@ -167,8 +167,8 @@ fn render(
         &RenderOptions {
             frames,
             hdr: true,
+            ruler: view == View::FINAL,
             view,
-            ruler: view == View::Final,
             ..RenderOptions::default()
         },
     )?;
@@ -210,8 +210,8 @@ impl<'a> Session<'a> {
         file.render.skybox = false;
         let mut scene = Scene::load(file)?;
         let reference = points::reference(opts);
-        let (ref_final, report) = render(ctx, &mut scene, reference, View::Final, 1)?;
-        let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::Diffuse, 1)?;
+        let (ref_final, report) = render(ctx, &mut scene, reference, View::FINAL, 1)?;
+        let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::named("diffuse"), 1)?;
         Ok(Self {
             ctx,
             opts,
@@ -228,11 +228,13 @@ impl<'a> Session<'a> {
     /// Renders and measures one point.
     pub fn point(&mut self, variant: Variant) -> Result<Point> {
         let (ctx, frames) = (self.ctx, self.opts.frames);
-        let (image, report) = render(ctx, &mut self.scene, variant, View::Final, frames)?;
-        let (diffuse, _) = render(ctx, &mut self.scene, variant, View::Diffuse, 1)?;
+        let (image, report) = render(ctx, &mut self.scene, variant, View::FINAL, frames)?;
+        let (diffuse, _) = render(ctx, &mut self.scene, variant, View::named("diffuse"), 1)?;
         let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
-        let is_ruler = |p: &PassStats| p.name.starts_with("ruler_");
-        let is_chain = |p: &PassStats| p.name.starts_with("blur") || p.name.starts_with("stretch");
+        // By the tags the passes declare (render::ruler::TAG, skin::TAG).
+        let tagged = |p: &PassStats, tag: &str| p.tags.iter().any(|t| t == tag);
+        let is_ruler = |p: &PassStats| tagged(p, crate::render::ruler::TAG);
+        let is_chain = |p: &PassStats| tagged(p, crate::skin::TAG);
         Ok(Point {
             id: variant.id(),
             variant,

@@ -61,7 +61,10 @@ impl App {
         App {
             controls: Controls {
                 file: opts.scene.clone(),
-                view: crate::render::View::Final,
+                view: crate::render::View::FINAL,
+                views: crate::render::Screen::all()
+                    .map(|s| s.name().to_string())
+                    .collect(),
                 orbit,
                 env_text: String::new(),
                 env_error: None,
@@ -149,6 +152,7 @@ impl App {
                         if f.rebuilt { " (new session)" } else { "" }
                     );
                     open.shown = Some(f.image);
+                    self.controls.views = f.views;
                     if let Some(r) = f.report {
                         self.timings.add_frame(r);
                     }
@@ -184,7 +188,7 @@ impl App {
         if !minimised && self.sent.as_ref() != Some(&(self.controls.clone(), size)) {
             open.worker.send(Job {
                 file: self.controls.file.clone(),
-                view: self.controls.view,
+                view: self.controls.view.clone(),
                 camera: self.controls.orbit.camera(),
                 size,
             });

@@ -7,7 +7,7 @@
 
 use super::camera::Orbit;
 use crate::profile::FrameReport;
-use crate::render::View;
+use crate::render::{Screen, View};
 use crate::scene::env::EnvSource;
 use crate::scene::file::{Chain, Kernel, LightsMode, Occlusion, SceneFile, ToneCurve};
 use std::collections::VecDeque;
@@ -24,6 +24,8 @@ pub const PANEL_WIDTH: u32 = 360;
 pub struct Controls {
     pub file: SceneFile,
     pub view: View,
+    /// What the view menu offers: the session's views (render::session).
+    pub views: Vec<String>,
     pub orbit: Orbit,
     /// The environment field: a source typed in (a file, `sky:…`, `uniform:…`).
     pub env_text: String,
@@ -178,8 +180,9 @@ fn controls(ui: &mut egui::Ui, c: &mut Controls, envs: &[(String, EnvSource)]) {
     egui::ComboBox::from_label("view")
         .selected_text(c.view.name())
         .show_ui(ui, |ui| {
-            for v in View::ALL.into_iter().filter(|v| *v != View::Reference) {
-                ui.selectable_value(&mut c.view, v, v.name());
+            // The CPU reference is too slow for a viewer.
+            for name in c.views.iter().filter(|n| *n != Screen::Reference.name()) {
+                ui.selectable_value(&mut c.view, View::named(name), name);
             }
         });
     let mut metered = f.render.exposure.is_none();

@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::gpu::{Context, Image};
 use crate::profile::FrameReport;
 use crate::render::session::Session;
-use crate::render::View;
+use crate::render::{Screen, View};
 use crate::scene::camera::Camera;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
@@ -39,6 +39,8 @@ pub struct Rendered {
     pub image: Arc<Image>,
     pub report: Option<FrameReport>,
     pub extracted_lights: usize,
+    /// The session's views (render::session::Session::views).
+    pub views: Vec<String>,
     /// Whether a new session was started for it (scene loaded, pipelines built).
     pub rebuilt: bool,
     /// Wall-clock time of the job, seconds.
@@ -118,6 +120,9 @@ fn serve(ctx: &Arc<Context>, inbox: &Receiver<Job>, outbox: &Sender<Done>) {
                 image,
                 report,
                 extracted_lights: extracted,
+                views: session
+                    .as_ref()
+                    .map_or_else(Vec::new, |(_, s)| s.views().to_vec()),
                 rebuilt,
                 seconds: started.elapsed().as_secs_f64(),
             });
@@ -143,7 +148,7 @@ fn render(
 ) -> Result<Frame> {
     let mut file = job.file.clone();
     // The test-texture view is the final image with the checker as albedo.
-    file.textures.test_texture |= job.view == View::TestTexture;
+    file.textures.test_texture |= job.view == View::Screen(Screen::TestTexture);
     let settings = session_settings(&file);
     let rebuilt = session.as_ref().is_none_or(|(made, _)| *made != settings);
     if rebuilt {
@@ -155,7 +160,7 @@ fn render(
     s.set_post(&file.render);
     s.set_rotation(file.environment.rotation_deg)?;
     s.set_camera(job.camera, job.size)?;
-    let (image, report) = s.render(job.view)?;
+    let (image, report) = s.render(&job.view)?;
     Ok((image, report, s.extracted_lights(), rebuilt))
 }
 
