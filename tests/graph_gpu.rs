@@ -314,3 +314,26 @@ fn a_background_executor_does_not_submit_while_the_foreground_is_held() {
         assert!(submitted.into_inner());
     });
 }
+
+#[test]
+fn a_pipeline_is_built_once_per_shader_and_constants() {
+    use dermis::gpu::{GraphicsDesc, Pipelines};
+    common::with_gpu(|ctx| {
+        let p = Pipelines::new(ctx);
+        let a = p.compute("blur.comp", &[7]).unwrap();
+        let again = p.compute("blur.comp", &[7]).unwrap();
+        assert!(Arc::ptr_eq(&a, &again));
+        let other = p.compute("blur.comp", &[0]).unwrap();
+        assert!(
+            !Arc::ptr_eq(&a, &other),
+            "other constants, another pipeline"
+        );
+        let desc = GraphicsDesc::fullscreen("background.frag", &[HALF]);
+        let g = p.graphics(&desc).unwrap();
+        assert!(Arc::ptr_eq(&g, &p.graphics(&desc).unwrap()));
+        assert_eq!(p.len(), 3);
+        // Another cache (another render) builds its own.
+        let fresh = Pipelines::new(ctx);
+        assert!(!Arc::ptr_eq(&a, &fresh.compute("blur.comp", &[7]).unwrap()));
+    });
+}

@@ -5,7 +5,7 @@
 
 mod common;
 
-use dermis::gpu::{ImageDesc, Sampler};
+use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::{upload_texture, Readback};
 use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::post::glow::{kernel, Glow};
@@ -31,7 +31,7 @@ fn the_glow_of_one_bright_pixel_is_the_two_gaussian_profile() {
         let desc = ImageDesc::new(w, h, dermis::testscene::HALF);
         let src = upload_texture(ctx, "impulse", desc, &common::to_f16_bytes(&texels)).unwrap();
         let glow = Glow::new(
-            ctx,
+            &Pipelines::new(ctx),
             Arc::new(Sampler::clamped(ctx, false).unwrap()),
             Arc::new(Sampler::clamped(ctx, true).unwrap()),
         )

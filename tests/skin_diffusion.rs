@@ -5,7 +5,7 @@
 mod common;
 
 use dermis::frame::MeshBuffers;
-use dermis::gpu::{Context, ImageDesc, Sampler};
+use dermis::gpu::{Context, ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::upload_texture;
 use dermis::graph::upload::Readback;
 use dermis::graph::{Access, Executor, Graph, Imported};
@@ -61,9 +61,10 @@ fn chain_with(
         let buffers = Arc::new(MeshBuffers::upload(ctx, mesh).unwrap());
         let profile = Profile::skin();
         let constant = (!correction).then(|| mean_stretch(mesh, N));
-        let stretch = StretchMaps::new(ctx, N, &profile, constant).unwrap();
-        let blur =
-            BlurChain::new(ctx, kernel, Arc::new(Sampler::clamped(ctx, true).unwrap())).unwrap();
+        let pipelines = Pipelines::new(ctx);
+        let stretch = StretchMaps::new(&pipelines, N, &profile, constant).unwrap();
+        let sampler = Arc::new(Sampler::clamped(ctx, true).unwrap());
+        let blur = BlurChain::new(&pipelines, kernel, sampler).unwrap();
         let plan = chain::plan(&profile, variant, N, mean_stretch(mesh, N));
         let readbacks: Vec<Readback> = plan
             .iter()

@@ -7,7 +7,7 @@
 
 mod common;
 
-use dermis::gpu::{ImageDesc, Sampler};
+use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::{upload_texture, Readback};
 use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::post::meter::{self, Meter, Metered};
@@ -24,8 +24,9 @@ fn tonemap(ramp: &[f32], exposure: Exposure, display: &Display) -> (Vec<u8>, Opt
         let desc = ImageDesc::new(W, 1, dermis::testscene::HALF);
         let src = upload_texture(ctx, "ramp", desc, &common::to_f16_bytes(ramp)).unwrap();
         let sampler = Arc::new(Sampler::clamped(ctx, false).unwrap());
-        let tonemap = Tonemap::new(ctx, sampler.clone()).unwrap();
-        let meter = Meter::new(ctx, sampler).unwrap();
+        let pipelines = Pipelines::new(ctx);
+        let tonemap = Tonemap::new(&pipelines, sampler.clone()).unwrap();
+        let meter = Meter::new(&pipelines, sampler).unwrap();
         let readback = Readback::new(ctx, "ldr", W as u64 * 4).unwrap();
         let metered = Readback::new(ctx, "exposure", meter::RESULT_BYTES).unwrap();
         let mut g = Graph::new();

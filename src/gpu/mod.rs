@@ -1,6 +1,7 @@
 //! A thin, RAII layer over ash: context (instance, device, validation), memory
 //! (gpu-allocator), images, buffers, samplers, pipelines, embedded SPIR-V.
 
+mod cache;
 mod context;
 mod pipeline;
 mod reflect;
@@ -9,6 +10,7 @@ pub mod shaders;
 mod swapchain;
 mod validation;
 
+pub use cache::{Memo, Pipelines};
 pub use context::{Context, ContextOptions, DeviceInfo, MemoryHeap};
 pub use pipeline::{GraphicsDesc, Pipeline};
 pub use reflect::ShaderLayout;

@@ -8,6 +8,7 @@ use ash::vk;
 use std::sync::Arc;
 
 /// Fixed-function state of a graphics pipeline (dynamic rendering, dynamic viewport).
+#[derive(Debug)]
 pub struct GraphicsDesc<'a> {
     pub vertex: &'a str,
     pub fragment: &'a str,

@@ -4,7 +4,7 @@
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
-use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
@@ -36,23 +36,20 @@ pub struct DirectPass {
 }
 
 impl DirectPass {
-    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant) -> Result<Self> {
         let lit = |fragment| {
-            Pipeline::graphics(
-                ctx,
-                &GraphicsDesc {
-                    vertex: "mesh_lit.vert",
-                    fragment,
-                    color_formats: &[HDR_FORMAT],
-                    depth_format: Some(DEPTH_FORMAT),
-                    depth_write: true,
-                    vertex_layout: Some(Vertex::layout()),
-                    // Scanned meshes are not reliably closed or consistently wound.
-                    cull_mode: vk::CullModeFlags::NONE,
-                    specialization: &variant.specialization(),
-                    alpha_blend: false,
-                },
-            )
+            pipelines.graphics(&GraphicsDesc {
+                vertex: "mesh_lit.vert",
+                fragment,
+                color_formats: &[HDR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_write: true,
+                vertex_layout: Some(Vertex::layout()),
+                // Scanned meshes are not reliably closed or consistently wound.
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &variant.specialization(),
+                alpha_blend: false,
+            })
         };
         Ok(Self {
             shading: lit("forward.frag")?,

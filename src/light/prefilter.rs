@@ -10,7 +10,7 @@
 //! only, into an image that outlives the frames; later frames read it.
 
 use crate::error::Result;
-use crate::gpu::{Context, Image, ImageDesc, Pipeline, Sampler};
+use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines, Sampler};
 use crate::graph::{Access, Graph, ImageHandle, Imported};
 use crate::scene::env::EnvMap;
 use crate::skin::specular::ks_brdf;
@@ -38,9 +38,10 @@ pub struct PrefilterPass {
 
 impl PrefilterPass {
     /// `sampler`: trilinear where the device filters the environment's format.
-    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
+        let ctx = pipelines.ctx();
         Ok(Self {
-            pipeline: Pipeline::compute(ctx, "env_prefilter.comp")?,
+            pipeline: pipelines.compute("env_prefilter.comp", &[])?,
             sampler,
             image: Arc::new(Image::new(
                 ctx,

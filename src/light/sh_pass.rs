@@ -6,7 +6,7 @@
 use super::sh::{self, Sh9};
 use crate::error::Result;
 use crate::frame::upload_env;
-use crate::gpu::{Buffer, Context, Image, MemoryLocation, Pipeline, Sampler};
+use crate::gpu::{Buffer, Context, Image, MemoryLocation, Pipeline, Pipelines, Sampler};
 use crate::graph::upload::{upload_buffer, Readback};
 use crate::graph::{Access, BufferHandle, Executor, Graph, Imported};
 use crate::profile::FrameReport;
@@ -106,10 +106,10 @@ fn transform(ctx: &Arc<Context>, rotation_deg: f32, intensity: f32) -> Result<Ar
 }
 
 impl ShPasses {
-    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
         Ok(Self {
-            project: Pipeline::compute(ctx, "sh_project.comp")?,
-            reduce: Pipeline::compute(ctx, "sh_reduce.comp")?,
+            project: pipelines.compute("sh_project.comp", &[])?,
+            reduce: pipelines.compute("sh_reduce.comp", &[])?,
             sampler,
         })
     }
@@ -158,7 +158,10 @@ pub fn project(
     intensity: f32,
 ) -> Result<(Sh9, FrameReport)> {
     let image = upload_env(ctx, env)?;
-    let passes = ShPasses::new(ctx, Arc::new(Sampler::clamped(ctx, false)?))?;
+    let passes = ShPasses::new(
+        &Pipelines::new(ctx),
+        Arc::new(Sampler::clamped(ctx, false)?),
+    )?;
     let buffers = ShBuffers::new(ctx, &image, rotation_deg, intensity)?;
     let readback = Readback::new(ctx, "sh readback", 9 * 16)?;
     let mut g = Graph::new();

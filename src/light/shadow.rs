@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::frame::{MeshBuffers, Vertex, SHADOW_FORMAT};
-use crate::gpu::{Context, GraphicsDesc, Image, ImageDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use crate::scene::LightSource;
 use ash::vk;
@@ -131,22 +131,24 @@ impl ShadowPass {
     /// The pass and atlas of the lights' `views` (`None`: unshadowed; the
     /// shadowed ones take tiles in order), `resolution` texels a side; a 1×1
     /// atlas when there are none, so the lighting shaders always have one to bind.
-    pub fn new(ctx: &Arc<Context>, views: &[Option<ShadowView>], resolution: u32) -> Result<Self> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex: "shadow.vert",
-                fragment: "shadow.frag",
-                color_formats: &[],
-                depth_format: Some(SHADOW_FORMAT),
-                depth_write: true,
-                // Positions only.
-                vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &[],
-                alpha_blend: false,
-            },
-        )?;
+    pub fn new(
+        pipelines: &Pipelines,
+        views: &[Option<ShadowView>],
+        resolution: u32,
+    ) -> Result<Self> {
+        let ctx = pipelines.ctx();
+        let pipeline = pipelines.graphics(&GraphicsDesc {
+            vertex: "shadow.vert",
+            fragment: "shadow.frag",
+            color_formats: &[],
+            depth_format: Some(SHADOW_FORMAT),
+            depth_write: true,
+            // Positions only.
+            vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
+            cull_mode: vk::CullModeFlags::NONE,
+            specialization: &[],
+            alpha_blend: false,
+        })?;
         let matrices = tile_matrices(views);
         let (cols, rows) = atlas_grid(matrices.len());
         let (w, h) = match matrices.len() {

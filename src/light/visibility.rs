@@ -9,7 +9,7 @@
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex};
-use crate::gpu::{Context, GraphicsDesc, Image, ImageDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use ash::vk;
 use std::sync::Arc;
@@ -38,22 +38,20 @@ impl VisibilityPass {
     /// The pass and its textures at min(`resolution`/2, [`MAX_RESOLUTION`])² for
     /// an irradiance texture of `resolution`²; 1×1 when no light is soft, so the
     /// shading passes always have them to bind.
-    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant, resolution: u32) -> Result<Self> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                vertex: "uv.vert",
-                fragment: "light_visibility.frag",
-                color_formats: &[FORMAT; TEXTURES],
-                depth_format: None,
-                depth_write: true,
-                vertex_layout: Some(Vertex::layout()),
-                // UV charts may be mirrored: both windings are surface.
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &variant.specialization(),
-                alpha_blend: false,
-            },
-        )?;
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, resolution: u32) -> Result<Self> {
+        let ctx = pipelines.ctx();
+        let pipeline = pipelines.graphics(&GraphicsDesc {
+            vertex: "uv.vert",
+            fragment: "light_visibility.frag",
+            color_formats: &[FORMAT; TEXTURES],
+            depth_format: None,
+            depth_write: true,
+            vertex_layout: Some(Vertex::layout()),
+            // UV charts may be mirrored: both windings are surface.
+            cull_mode: vk::CullModeFlags::NONE,
+            specialization: &variant.specialization(),
+            alpha_blend: false,
+        })?;
         let soft = variant.soft != 0;
         let side = if soft {
             (resolution / 2).clamp(1, MAX_RESOLUTION)

@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::frame::{upload_rgba8, FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
-use crate::gpu::{Context, GraphicsDesc, Image, ImageDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use crate::scene::texture::Texture;
 use ash::vk;
@@ -93,22 +93,20 @@ pub struct DebugPass {
 }
 
 impl DebugPass {
-    pub fn new(ctx: &Arc<Context>, regions: &Texture) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, regions: &Texture) -> Result<Self> {
+        let ctx = pipelines.ctx();
         Ok(Self {
-            pipeline: Pipeline::graphics(
-                ctx,
-                &GraphicsDesc {
-                    vertex: "mesh.vert",
-                    fragment: "debug_view.frag",
-                    color_formats: &[HDR_FORMAT],
-                    depth_format: Some(DEPTH_FORMAT),
-                    depth_write: true,
-                    vertex_layout: Some(Vertex::layout()),
-                    cull_mode: vk::CullModeFlags::NONE,
-                    specialization: &[],
-                    alpha_blend: false,
-                },
-            )?,
+            pipeline: pipelines.graphics(&GraphicsDesc {
+                vertex: "mesh.vert",
+                fragment: "debug_view.frag",
+                color_formats: &[HDR_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_write: true,
+                vertex_layout: Some(Vertex::layout()),
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &[],
+                alpha_blend: false,
+            })?,
             regions: upload_rgba8(ctx, "region ids", regions)?,
         })
     }

@@ -16,7 +16,7 @@
 
 use crate::error::Result;
 use crate::frame::HDR_FORMAT;
-use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline, Sampler};
+use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines, Sampler};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use std::sync::Arc;
 
@@ -77,14 +77,11 @@ pub struct Glow {
 }
 
 impl Glow {
-    pub fn new(ctx: &Arc<Context>, nearest: Arc<Sampler>, linear: Arc<Sampler>) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, nearest: Arc<Sampler>, linear: Arc<Sampler>) -> Result<Self> {
         Ok(Self {
-            down: Pipeline::compute(ctx, "glow_down.comp")?,
-            blur: Pipeline::compute(ctx, "glow_blur.comp")?,
-            composite: Pipeline::graphics(
-                ctx,
-                &GraphicsDesc::fullscreen("glow.frag", &[HDR_FORMAT]),
-            )?,
+            down: pipelines.compute("glow_down.comp", &[])?,
+            blur: pipelines.compute("glow_blur.comp", &[])?,
+            composite: pipelines.graphics(&GraphicsDesc::fullscreen("glow.frag", &[HDR_FORMAT]))?,
             nearest,
             linear,
         })

@@ -8,7 +8,7 @@
 //! afterwards. [`exposure`] is the CPU reference.
 
 use crate::error::Result;
-use crate::gpu::{Buffer, Context, MemoryLocation, Pipeline, Sampler};
+use crate::gpu::{Buffer, MemoryLocation, Pipeline, Pipelines, Sampler};
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle, Imported};
 use ash::vk;
 use std::sync::Arc;
@@ -111,7 +111,8 @@ fn tiles_of(width: u32, height: u32) -> [u32; 2] {
 impl Meter {
     /// For images of any size the device allows: a screen view at any window
     /// size, a UV-space view at its own resolution (the viewer meters both).
-    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
+        let ctx = pipelines.ctx();
         let max = ctx.info.max_image_dimension_2d;
         let [x, y] = tiles_of(max, max);
         let tile_count = u64::from(x) * u64::from(y);
@@ -126,8 +127,8 @@ impl Meter {
             .map(Arc::new)
         };
         Ok(Self {
-            tiles: Pipeline::compute(ctx, "meter.comp")?,
-            reduce: Pipeline::compute(ctx, "meter_reduce.comp")?,
+            tiles: pipelines.compute("meter.comp", &[])?,
+            reduce: pipelines.compute("meter_reduce.comp", &[])?,
             sampler,
             partials: buffer(
                 "meter partials",

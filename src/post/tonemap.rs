@@ -14,7 +14,7 @@
 
 use super::{Display, Exposure};
 use crate::error::Result;
-use crate::gpu::{Context, GraphicsDesc, Pipeline, Sampler};
+use crate::gpu::{GraphicsDesc, Pipeline, Pipelines, Sampler};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use crate::scene::file::{Gamma, ToneCurve};
 use ash::vk;
@@ -111,11 +111,9 @@ pub struct Tonemap {
 }
 
 impl Tonemap {
-    pub fn new(ctx: &Arc<Context>, sampler: Arc<Sampler>) -> Result<Self> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc::fullscreen("tonemap.frag", &[LDR_FORMAT]),
-        )?;
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
+        let pipeline =
+            pipelines.graphics(&GraphicsDesc::fullscreen("tonemap.frag", &[LDR_FORMAT]))?;
         Ok(Self { pipeline, sampler })
     }
 

@@ -4,14 +4,14 @@
 //! for; the graph runs only the passes it depends on (graph::cull), and what
 //! a render computes once is kept by key (graph::Kept).
 
-use super::ruler::Ruler;
+use super::ruler;
 use super::view::{Screen, Shown, View};
 use crate::error::{Error, Result};
 use crate::frame::{
     upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, ShaderVariant,
     HDR_FORMAT, MAX_LIGHTS,
 };
-use crate::gpu::{Context, ImageDesc};
+use crate::gpu::{Context, ImageDesc, Pipelines};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle};
 use crate::light::direct::DirectPass;
@@ -20,7 +20,7 @@ use crate::light::lighting::Lighting;
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass};
-use crate::light::skybox::SkyboxPass;
+use crate::light::skybox;
 use crate::light::visibility::{VisibilityPass, TEXTURES};
 use crate::post::debug::{DebugPass, DepthRange};
 use crate::post::glow::Glow;
@@ -170,9 +170,9 @@ fn frame_inputs(
     })
 }
 
-/// The frame's passes, each with its pipelines.
+/// The frame's passes that own more than their pipelines (images, buffers,
+/// the lights' projections); the rest are free functions.
 struct Passes {
-    skybox: SkyboxPass,
     direct: DirectPass,
     stretch: StretchMaps,
     irradiance: IrradiancePass,
@@ -186,41 +186,33 @@ struct Passes {
     glow: Glow,
     tonemap: Tonemap,
     sh: ShPasses,
-    /// Timed beside the chain, over the irradiance (render --ruler).
-    ruler: Option<Ruler>,
 }
 
 impl Passes {
     fn new(
-        ctx: &Arc<Context>,
+        p: &Pipelines,
         scene: &Scene,
         inputs: &FrameInputs,
         lighting: &Lighting,
         skin: &SkinSettings,
-        ruler: bool,
     ) -> Result<Self> {
         let (variant, s) = (&inputs.variant, &inputs.samplers);
         let res = skin.resolution;
         let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
         Ok(Self {
-            skybox: SkyboxPass::new(ctx)?,
-            direct: DirectPass::new(ctx, variant)?,
-            stretch: StretchMaps::new(ctx, res, &skin.profile, constant_stretch)?,
-            irradiance: IrradiancePass::new(ctx, variant)?,
-            blur: BlurChain::new(ctx, &skin.kernel, s.linear.clone())?,
-            shade: ShadePass::new(ctx, variant)?,
-            shadow: ShadowPass::new(ctx, &lighting.views, lighting.shadow_resolution)?,
-            visibility: VisibilityPass::new(ctx, variant, res)?,
-            prefilter: PrefilterPass::new(ctx, inputs.env_sampler.clone())?,
-            debug: DebugPass::new(ctx, &scene.regions)?,
-            meter: Meter::new(ctx, s.nearest.clone())?,
-            glow: Glow::new(ctx, s.nearest.clone(), s.linear.clone())?,
-            tonemap: Tonemap::new(ctx, s.nearest.clone())?,
-            sh: ShPasses::new(ctx, s.nearest.clone())?,
-            ruler: match ruler {
-                true => Some(Ruler::new(ctx, s.nearest.clone())?),
-                false => None,
-            },
+            direct: DirectPass::new(p, variant)?,
+            stretch: StretchMaps::new(p, res, &skin.profile, constant_stretch)?,
+            irradiance: IrradiancePass::new(p, variant)?,
+            blur: BlurChain::new(p, &skin.kernel, s.linear.clone())?,
+            shade: ShadePass::new(p, variant)?,
+            shadow: ShadowPass::new(p, &lighting.views, lighting.shadow_resolution)?,
+            visibility: VisibilityPass::new(p, variant, res)?,
+            prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
+            debug: DebugPass::new(p, &scene.regions)?,
+            meter: Meter::new(p, s.nearest.clone())?,
+            glow: Glow::new(p, s.nearest.clone(), s.linear.clone())?,
+            tonemap: Tonemap::new(p, s.nearest.clone())?,
+            sh: ShPasses::new(p, s.nearest.clone())?,
         })
     }
 }
@@ -230,6 +222,8 @@ impl Passes {
 pub(super) struct Frame {
     inputs: FrameInputs,
     tables: SpecularTables,
+    /// The render's pipelines, each built once (gpu::Pipelines).
+    pipelines: Pipelines,
     passes: Passes,
     lighting: Lighting,
     sh_buffers: ShBuffers,
@@ -242,6 +236,8 @@ pub(super) struct Frame {
     specular_scale: f32,
     /// render.skybox: draw the environment behind the head.
     skybox_on: bool,
+    /// Time the rulers beside the chain, over the irradiance (render --ruler).
+    ruler: bool,
     /// Where the depth view's 1 and 0 lie.
     depth_range: DepthRange,
     pub(super) post: PostSettings,
@@ -312,9 +308,12 @@ impl Frame {
         );
         let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
         let env = &scene.file.environment;
+        let pipelines = Pipelines::new(ctx);
         Ok(Self {
             tables,
-            passes: Passes::new(ctx, scene, &inputs, &lighting, &skin, ruler)?,
+            passes: Passes::new(&pipelines, scene, &inputs, &lighting, &skin)?,
+            pipelines,
+            ruler,
             sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, env.rotation_deg, env.intensity)?,
             inputs,
             lighting,
@@ -457,16 +456,16 @@ impl Frame {
         let mut hdr = g.create_image("hdr", ImageDesc::new(w, h, HDR_FORMAT));
         let (p, inputs) = (&self.passes, &self.inputs);
         match screen {
-            Screen::Skin(mode) => self.skin(g, mode, light, &mut hdr),
+            Screen::Skin(mode) => self.skin(g, mode, light, &mut hdr)?,
             // The frame was made with the checker as its albedo.
-            Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr),
+            Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr)?,
             Screen::Direct(view) => {
-                p.skybox.pass(g, inputs, &mut hdr, self.skybox_on);
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.skybox_on)?;
                 let (sh, shadows, soft) = (&light.sh, &light.shadows, &light.soft);
                 p.direct.pass(g, view, inputs, sh, shadows, soft, &mut hdr);
             }
             Screen::Debug(view) => {
-                p.skybox.pass(g, inputs, &mut hdr, false);
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, false)?;
                 p.debug.pass(g, view, inputs, self.depth_range, &mut hdr);
             }
             Screen::Reference => {
@@ -479,7 +478,13 @@ impl Frame {
     }
 
     /// Texture-space diffusion and the skin pass in `mode`, into `hdr`.
-    fn skin(&self, g: &mut Graph, mode: ShadeMode, light: &LightImages, hdr: &mut ImageHandle) {
+    fn skin(
+        &self,
+        g: &mut Graph,
+        mode: ShadeMode,
+        light: &LightImages,
+        hdr: &mut ImageHandle,
+    ) -> Result<()> {
         let (p, inputs) = (&self.passes, &self.inputs);
         let stretch = p.stretch.pass(g, &inputs.mesh, &p.blur);
         let irradiance = p.irradiance.pass(
@@ -491,12 +496,12 @@ impl Frame {
             self.skin.resolution,
             self.skin.mix,
         );
-        if let Some(r) = &p.ruler {
-            r.passes(g, &irradiance);
+        if self.ruler {
+            ruler::passes(g, &self.pipelines, &inputs.samplers.nearest, &irradiance)?;
         }
         let blurred = p.blur.chain(g, &irradiance, &stretch, &self.levels);
         let specular_env = p.prefilter.pass(g, &inputs.lighting_env);
-        p.skybox.pass(g, inputs, hdr, self.skybox_on);
+        skybox::pass(g, &self.pipelines, inputs, hdr, self.skybox_on)?;
         let settings = ShadeSettings {
             weights: self.weights,
             mix: self.skin.mix,
@@ -511,6 +516,7 @@ impl Frame {
             specular_env: &specular_env,
         };
         p.shade.pass(g, inputs, &self.tables, images, settings, hdr);
+        Ok(())
     }
 
     /// Metering, glow and tone mapping of a screen image `hdr` shown as `shown`.

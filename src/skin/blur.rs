@@ -13,7 +13,7 @@ use super::chain::Level;
 use super::profile::Kernel;
 use super::UV_FORMAT;
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, Context, ImageDesc, Pipeline, Sampler};
+use crate::gpu::{Buffer, ImageDesc, Pipeline, Pipelines, Sampler};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, Graph, ImageHandle};
 use std::sync::Arc;
@@ -45,7 +45,8 @@ pub struct BlurChain {
 }
 
 impl BlurChain {
-    pub fn new(ctx: &Arc<Context>, kernel: &BlurKernel, sampler: Arc<Sampler>) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, kernel: &BlurKernel, sampler: Arc<Sampler>) -> Result<Self> {
+        let ctx = pipelines.ctx();
         // std140: one vec4 (offset in σ, weight, 0, 0) per tap.
         let mut taps = [[0.0f32; 4]; MAX_FIXED_TAPS];
         let tap_count = match kernel {
@@ -64,7 +65,7 @@ impl BlurChain {
             BlurKernel::Accurate => 0,
         };
         Ok(Self {
-            pipeline: Pipeline::compute_specialized(ctx, "blur.comp", &[tap_count])?,
+            pipeline: pipelines.compute("blur.comp", &[tap_count])?,
             taps: upload_buffer(
                 ctx,
                 "blur kernel",

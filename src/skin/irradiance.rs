@@ -5,7 +5,7 @@ use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant};
-use crate::gpu::{Context, ImageDesc, Pipeline};
+use crate::gpu::{ImageDesc, Pipeline, Pipelines};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use std::sync::Arc;
 
@@ -14,10 +14,10 @@ pub struct IrradiancePass {
 }
 
 impl IrradiancePass {
-    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant) -> Result<Self> {
         Ok(Self {
             pipeline: uv_pipeline(
-                ctx,
+                pipelines,
                 "uv_lit.vert",
                 "irradiance.frag",
                 &variant.specialization(),

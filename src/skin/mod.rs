@@ -13,7 +13,7 @@ pub mod tables;
 
 use crate::error::{Error, Result};
 use crate::frame::Vertex;
-use crate::gpu::{Context, GraphicsDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, Pipeline, Pipelines};
 use crate::scene::file::{Chain, Kernel as KernelChoice, Render, Skin, SpecularRegion};
 use crate::scene::mesh::Mesh;
 use ash::vk;
@@ -128,24 +128,21 @@ pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
 
 /// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.
 pub(crate) fn uv_pipeline(
-    ctx: &Arc<Context>,
+    pipelines: &Pipelines,
     vertex: &str,
     fragment: &str,
     specialization: &[u32],
 ) -> Result<Arc<Pipeline>> {
-    Pipeline::graphics(
-        ctx,
-        &GraphicsDesc {
-            vertex,
-            fragment,
-            color_formats: &[UV_FORMAT],
-            depth_format: None,
-            depth_write: true,
-            vertex_layout: Some(Vertex::layout()),
-            // UV charts may be mirrored: both windings are surface.
-            cull_mode: vk::CullModeFlags::NONE,
-            specialization,
-            alpha_blend: false,
-        },
-    )
+    pipelines.graphics(&GraphicsDesc {
+        vertex,
+        fragment,
+        color_formats: &[UV_FORMAT],
+        depth_format: None,
+        depth_write: true,
+        vertex_layout: Some(Vertex::layout()),
+        // UV charts may be mirrored: both windings are surface.
+        cull_mode: vk::CullModeFlags::NONE,
+        specialization,
+        alpha_blend: false,
+    })
 }

@@ -5,7 +5,7 @@
 use super::tables::SpecularTables;
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
-use crate::gpu::{Context, GraphicsDesc, ImageDesc, Pipeline};
+use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
@@ -76,24 +76,21 @@ pub struct ShadePass {
 }
 
 impl ShadePass {
-    pub fn new(ctx: &Arc<Context>, variant: &ShaderVariant) -> Result<Self> {
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant) -> Result<Self> {
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
-            Pipeline::graphics(
-                ctx,
-                &GraphicsDesc {
-                    vertex: "mesh_lit.vert",
-                    fragment,
-                    color_formats,
-                    depth_format: Some(DEPTH_FORMAT),
-                    depth_write,
-                    vertex_layout: Some(Vertex::layout()),
-                    cull_mode: vk::CullModeFlags::NONE,
-                    specialization: &variant.specialization(),
-                    alpha_blend: false,
-                },
-            )
+            pipelines.graphics(&GraphicsDesc {
+                vertex: "mesh_lit.vert",
+                fragment,
+                color_formats,
+                depth_format: Some(DEPTH_FORMAT),
+                depth_write,
+                vertex_layout: Some(Vertex::layout()),
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &variant.specialization(),
+                alpha_blend: false,
+            })
         };
         Ok(Self {
             depth: mesh("depth_only.frag", &[], true)?,

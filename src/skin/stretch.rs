@@ -10,7 +10,7 @@ use super::profile::Profile;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::frame::MeshBuffers;
-use crate::gpu::{Context, Image, ImageDesc, Pipeline};
+use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use ash::vk;
 use std::sync::Arc;
@@ -33,11 +33,12 @@ pub struct StretchMaps {
 impl StretchMaps {
     /// Stretch maps for an irradiance chain at `resolution`² with `profile`.
     pub fn new(
-        ctx: &Arc<Context>,
+        pipelines: &Pipelines,
         resolution: u32,
         profile: &Profile,
         constant: Option<f32>,
     ) -> Result<Self> {
+        let ctx = pipelines.ctx();
         let side = resolution.min(MAX_RESOLUTION);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::STORAGE
@@ -52,7 +53,7 @@ impl StretchMaps {
             })
             .collect::<Result<_>>()?;
         Ok(Self {
-            pipeline: uv_pipeline(ctx, "uv.vert", "stretch.frag", &[])?,
+            pipeline: uv_pipeline(pipelines, "uv.vert", "stretch.frag", &[])?,
             levels,
             constant,
             increments,
