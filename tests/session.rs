@@ -167,3 +167,32 @@ fn a_session_after_set_camera_is_a_fresh_session_with_that_camera() {
         }
     });
 }
+
+#[test]
+fn a_session_takes_post_and_rotation_changes_and_needs_a_new_one_for_the_rest() {
+    use dermis::scene::file::{Gamma, ToneCurve};
+    let scene = scan((48, 60));
+    let mut live = scene.clone();
+    let r = &mut live.file.render;
+    (r.gamma, r.tone_curve, r.exposure) = (Gamma::Power(1.8), ToneCurve::Aces, Some(0.5));
+    (r.glow, r.skybox) = (true, false);
+    live.file.environment.rotation_deg = 40.0;
+    common::with_gpu(|ctx| {
+        let mut fresh = Session::new(ctx, live.clone()).unwrap();
+        let (image, _) = fresh.render(&View::FINAL).unwrap();
+        let expected = pixels(ctx, &image);
+        let mut session = Session::new(ctx, scene.clone()).unwrap();
+        session.render(&View::FINAL).unwrap();
+        assert!(
+            session.update(&live.file).unwrap(),
+            "post and rotation are live"
+        );
+        let (image, _) = session.render(&View::FINAL).unwrap();
+        let n = differing(&pixels(ctx, &image), &expected);
+        assert_eq!(n, 0, "bytes differing from a fresh session");
+        // The irradiance resolution is not.
+        let mut other = live.file.clone();
+        other.render.irradiance_resolution = 512;
+        assert!(!session.update(&other).unwrap());
+    });
+}

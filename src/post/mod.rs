@@ -64,11 +64,31 @@ pub struct PostSettings {
     pub glow: Option<f32>,
     pub exposure: Exposure,
     pub display: Display,
+    /// `render.skybox`: the environment drawn behind the head.
+    pub skybox: bool,
 }
 
 impl PostSettings {
+    /// `render` without what post-processing reads (those keys at their
+    /// defaults): what a change of post settings leaves alone. The keys
+    /// [`PostSettings::resolve`] reads are cleared here, and nowhere else.
+    pub fn clear(render: &Render) -> Render {
+        let d = Render::default();
+        Render {
+            exposure: d.exposure,
+            gamma: d.gamma,
+            tone_curve: d.tone_curve,
+            skybox: d.skybox,
+            background: d.background,
+            glow: d.glow,
+            glow_intensity: d.glow_intensity,
+            ..render.clone()
+        }
+    }
+
     pub fn resolve(render: &Render) -> PostSettings {
         PostSettings {
+            skybox: render.skybox,
             glow: render.glow.then_some(render.glow_intensity),
             exposure: render.exposure.map_or(Exposure::Metered, Exposure::Given),
             display: Display {
@@ -83,5 +103,46 @@ impl PostSettings {
                 },
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clear_takes_out_exactly_what_resolve_reads() {
+        // Every key off its default (no `..`: a new key must be placed here).
+        let r = Render {
+            width: 7,
+            height: 9,
+            irradiance_resolution: 512,
+            shadow_resolution: 256,
+            exposure: Some(1.5),
+            gamma: Gamma::Power(1.8),
+            tone_curve: ToneCurve::Aces,
+            skybox: false,
+            background: [0.2, 0.3, 0.4],
+            glow: true,
+            glow_intensity: 2.0,
+        };
+        let d = Render::default();
+        assert_ne!(PostSettings::resolve(&r), PostSettings::resolve(&d));
+        let cleared = PostSettings::clear(&r);
+        assert_eq!(PostSettings::resolve(&cleared), PostSettings::resolve(&d));
+        // What it keeps: the rest, as it was.
+        assert_eq!(
+            (cleared.width, cleared.height),
+            (r.width, r.height),
+            "the size is not post-processing"
+        );
+        assert_eq!(
+            (cleared.irradiance_resolution, cleared.shadow_resolution),
+            (r.irradiance_resolution, r.shadow_resolution)
+        );
+        assert_ne!(
+            (d.width, d.irradiance_resolution, d.shadow_resolution),
+            (r.width, r.irradiance_resolution, r.shadow_resolution)
+        );
     }
 }

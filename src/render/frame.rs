@@ -234,8 +234,6 @@ pub(super) struct Frame {
     levels: Vec<Level>,
     /// 0.5 over the specular map's mean (frame uniforms).
     specular_scale: f32,
-    /// render.skybox: draw the environment behind the head.
-    skybox_on: bool,
     /// Time the rulers beside the chain, over the irradiance (render --ruler).
     ruler: bool,
     /// Where the depth view's 1 and 0 lie.
@@ -321,7 +319,6 @@ impl Frame {
             skin,
             levels,
             specular_scale,
-            skybox_on: scene.file.render.skybox,
             depth_range: depth_range(scene),
             post: PostSettings::resolve(&scene.file.render),
         })
@@ -460,7 +457,7 @@ impl Frame {
             // The frame was made with the checker as its albedo.
             Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr)?,
             Screen::Direct(view) => {
-                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.skybox_on)?;
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.post.skybox)?;
                 let (sh, shadows, soft) = (&light.sh, &light.shadows, &light.soft);
                 p.direct.pass(g, view, inputs, sh, shadows, soft, &mut hdr);
             }
@@ -501,7 +498,7 @@ impl Frame {
         }
         let blurred = p.blur.chain(g, &irradiance, &stretch, &self.levels);
         let specular_env = p.prefilter.pass(g, &inputs.lighting_env);
-        skybox::pass(g, &self.pipelines, inputs, hdr, self.skybox_on)?;
+        skybox::pass(g, &self.pipelines, inputs, hdr, self.post.skybox)?;
         let settings = ShadeSettings {
             weights: self.weights,
             mix: self.skin.mix,

@@ -12,6 +12,7 @@ use crate::graph::{Access, Executor, Graph, Imported, Kept};
 use crate::post::PostSettings;
 use crate::profile::FrameReport;
 use crate::scene::camera::Camera;
+use crate::scene::file::SceneFile;
 use crate::scene::Scene;
 use ash::vk;
 use std::sync::Arc;
@@ -62,6 +63,31 @@ impl Session {
         self.frame.extracted_lights()
     }
 
+    /// Takes `file` for the next frames when it differs from the session's
+    /// scene only in what a session changes between frames: the camera and
+    /// the size (see [`Session::set_camera`]), the environment's rotation and
+    /// the post-processing (post::PostSettings); returns false, taking
+    /// nothing, when it needs a new session. The one place that decides.
+    pub fn update(&mut self, file: &SceneFile) -> Result<bool> {
+        let fixed = |f: &SceneFile| {
+            let mut f = f.clone();
+            f.render = PostSettings::clear(&f.render);
+            (f.render.width, f.render.height) = (0, 0);
+            f.camera = Default::default();
+            f.environment.rotation_deg = 0.0;
+            f
+        };
+        if fixed(file) != fixed(&self.scene.file) {
+            return Ok(false);
+        }
+        let size = (self.scene.file.render.width, self.scene.file.render.height);
+        self.scene.file.render = file.render.clone();
+        (self.scene.file.render.width, self.scene.file.render.height) = size;
+        self.frame.set_post(PostSettings::resolve(&file.render));
+        self.set_rotation(file.environment.rotation_deg)?;
+        Ok(true)
+    }
+
     /// Turns the environment (`environment.rotation_deg`) without a new session:
     /// its SH are rotated, its extracted sources turned with their shadows.
     pub fn set_rotation(&mut self, rotation_deg: f32) -> Result<()> {
@@ -70,12 +96,6 @@ impl Session {
         }
         self.scene.file.environment.rotation_deg = rotation_deg;
         self.frame.set_rotation(&self.ctx, &self.scene)
-    }
-
-    /// Replaces the post-processing settings (`render`'s exposure, tone curve,
-    /// glow, background): read when the next frame's graph is built.
-    pub fn set_post(&mut self, render: &crate::scene::file::Render) {
-        self.frame.set_post(PostSettings::resolve(render));
     }
 
     /// Moves the camera and sets the frame's size (its aspect): uniforms only.

@@ -107,7 +107,7 @@ impl Drop for Worker {
 /// The thread's loop: the newest job of those waiting, rendered; its answer
 /// stands for the skipped ones too.
 fn serve(ctx: &Arc<Context>, inbox: &Receiver<Job>, outbox: &Sender<Done>) {
-    let mut session: Option<(SceneFile, Session)> = None;
+    let mut session: Option<Session> = None;
     while let Ok(mut job) = inbox.recv() {
         let mut skipped = 0;
         while let Ok(newer) = inbox.try_recv() {
@@ -122,7 +122,7 @@ fn serve(ctx: &Arc<Context>, inbox: &Receiver<Job>, outbox: &Sender<Done>) {
                 extracted_lights: extracted,
                 views: session
                     .as_ref()
-                    .map_or_else(Vec::new, |(_, s)| s.views().to_vec()),
+                    .map_or_else(Vec::new, |s| s.views().to_vec()),
                 rebuilt,
                 seconds: started.elapsed().as_secs_f64(),
             });
@@ -139,53 +139,23 @@ fn serve(ctx: &Arc<Context>, inbox: &Receiver<Job>, outbox: &Sender<Done>) {
 
 type Frame = (Arc<Image>, Option<FrameReport>, usize, bool);
 
-/// One job on `session`, started again when the job's settings (camera and size
-/// aside) differ from the ones it was made with.
-fn render(
-    ctx: &Arc<Context>,
-    session: &mut Option<(SceneFile, Session)>,
-    job: &Job,
-) -> Result<Frame> {
+/// One job on `session`, started again when it cannot take the job's settings
+/// (render::session::Session::update decides).
+fn render(ctx: &Arc<Context>, session: &mut Option<Session>, job: &Job) -> Result<Frame> {
     let mut file = job.file.clone();
     // The test-texture view is the final image with the checker as albedo.
     file.textures.test_texture |= job.view == View::Screen(Screen::TestTexture);
-    let settings = session_settings(&file);
-    let rebuilt = session.as_ref().is_none_or(|(made, _)| *made != settings);
-    if rebuilt {
+    let taken = match session {
+        Some(s) => s.update(&file)?,
+        None => false,
+    };
+    if !taken {
         *session = None; // free the old one's memory first
         (file.render.width, file.render.height) = job.size;
-        *session = Some((settings, Session::new(ctx, Scene::load(file.clone())?)?));
+        *session = Some(Session::new(ctx, Scene::load(file)?)?);
     }
-    let (_, s) = session.as_mut().expect("made above");
-    s.set_post(&file.render);
-    s.set_rotation(file.environment.rotation_deg)?;
+    let s = session.as_mut().expect("made above");
     s.set_camera(job.camera, job.size)?;
     let (image, report) = s.render(&job.view)?;
-    Ok((image, report, s.extracted_lights(), rebuilt))
-}
-
-/// The settings that need a new session when they change: all but the camera,
-/// the size, the environment's rotation and the post-processing (exposure, tone
-/// curve, glow, background), which a session takes as they come.
-fn session_settings(file: &SceneFile) -> SceneFile {
-    let mut f = file.clone();
-    let default = SceneFile::default();
-    f.camera = default.camera;
-    f.environment.rotation_deg = default.environment.rotation_deg;
-    let r = &mut f.render;
-    (r.width, r.height) = (0, 0);
-    (
-        r.exposure,
-        r.tone_curve,
-        r.glow,
-        r.glow_intensity,
-        r.background,
-    ) = (
-        default.render.exposure,
-        default.render.tone_curve,
-        default.render.glow,
-        default.render.glow_intensity,
-        default.render.background,
-    );
-    f
+    Ok((image, report, s.extracted_lights(), !taken))
 }
