@@ -17,15 +17,29 @@ pub struct InfoArgs {
 #[derive(Args)]
 pub struct EnvArg {
     /// A .hdr/.exr file, a cross, `cube:...`, `uniform:R,G,B` or `sky[:...]`.
-    #[arg(value_parser = parse_env_source)]
-    env: EnvSource,
+    #[arg(value_parser = named_env)]
+    env: NamedEnv,
+}
+
+/// A source as parsed and as given (printed back as given).
+#[derive(Clone)]
+struct NamedEnv {
+    text: String,
+    source: EnvSource,
+}
+
+fn named_env(s: &str) -> Result<NamedEnv, String> {
+    Ok(NamedEnv {
+        text: s.to_string(),
+        source: parse_env_source(s)?,
+    })
 }
 
 impl EnvArg {
     /// The map, procedural sources at `PROCEDURAL_ENV_SIZE`.
     fn map(&self) -> dermis::Result<EnvMap> {
         let (w, h) = dermis::scene::PROCEDURAL_ENV_SIZE;
-        Ok(env::resolve(&self.env, w, h)?.0)
+        Ok(env::resolve(&self.env.source, w, h)?.0)
     }
 }
 
@@ -114,7 +128,7 @@ pub fn sh(args: ShArgs, context: &ContextOptions) -> dermis::Result<()> {
             .map(|(n, c)| (n.to_string(), serde_json::json!([c.x, c.y, c.z])))
             .collect();
         let out = serde_json::json!({
-            "environment": args.env.env,
+            "environment": args.env.env.text,
             "rotation_deg": args.rotate,
             "order": names,
             "coefficients": obj,
@@ -166,7 +180,7 @@ pub fn lights(args: LightsArgs) -> dermis::Result<()> {
             })
             .collect();
         let out = serde_json::json!({
-            "environment": env.env,
+            "environment": env.env.text,
             "rotation_deg": rotate,
             "mode": lights,
             "lights": lights_json,
@@ -177,7 +191,7 @@ pub fn lights(args: LightsArgs) -> dermis::Result<()> {
     }
     println!(
         "{}, rotated {rotate}°, lights {lights}: {} found",
-        env.env,
+        env.env.text,
         rows.len()
     );
     if !rows.is_empty() {
