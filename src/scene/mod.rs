@@ -8,6 +8,7 @@ pub mod file;
 pub mod gltf;
 pub mod head;
 pub mod mesh;
+pub mod overrides;
 pub mod texture;
 
 #[cfg(test)]
@@ -16,88 +17,16 @@ mod uv_origin_tests;
 use crate::error::Result;
 use camera::Camera;
 use env::EnvMap;
-use file::{LightKind, Occlusion, SceneFile, UvOrigin};
+use file::{LightKind, SceneFile, UvOrigin};
 use glam::Vec3;
 use mesh::Mesh;
+pub use overrides::{Overrides, SceneArg};
 use std::path::PathBuf;
 use texture::{Encoding, Texture};
 
 /// Size of procedural environments (`uniform:`, `sky`): 1024×512, the size of the
 /// CC0 maps in assets/env.
 pub const PROCEDURAL_ENV_SIZE: (u32, u32) = (1024, 512);
-
-/// CLI flags that override the scene file's common fields.
-#[derive(Clone, Debug, Default)]
-pub struct Overrides {
-    pub mesh: Option<PathBuf>,
-    pub mm_per_unit: Option<f32>,
-    /// `--env`: a source string, parsed by [`Overrides::apply`].
-    pub env: Option<String>,
-    pub env_rotate_deg: Option<f32>,
-    /// `--env-lights`: replaces `environment.lights`.
-    pub env_lights: Option<file::LightsMode>,
-    pub exposure: Option<f32>,
-    pub irradiance_resolution: Option<u32>,
-    pub occlusion: Option<Occlusion>,
-    pub kernel: Option<file::Kernel>,
-    pub chain: Option<file::Chain>,
-    /// `--uv-origin`: replaces `textures.uv_origin`.
-    pub uv_origin: Option<UvOrigin>,
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub blur_width: Option<f32>,
-    pub blur_amount: Option<f32>,
-    pub test_texture: Option<bool>,
-    pub tone_curve: Option<file::ToneCurve>,
-    pub skybox: Option<bool>,
-    pub background: Option<[f32; 3]>,
-    pub glow: Option<bool>,
-    pub glow_intensity: Option<f32>,
-}
-
-impl Overrides {
-    /// Applies the overrides and re-validates the result.
-    pub fn apply(&self, mut file: SceneFile) -> Result<SceneFile> {
-        if self.mesh.is_some() {
-            file.mesh = self.mesh.clone();
-        }
-        file.mm_per_unit = self.mm_per_unit.or(file.mm_per_unit);
-        if let Some(env) = &self.env {
-            // Parsed like the scene file's `environment.source`.
-            if env.trim().is_empty() {
-                return Err(crate::Error::Input(format!(
-                    "command line: {}",
-                    file::EMPTY_ENV_SOURCE
-                )));
-            }
-            file.environment.source = env.parse()?;
-        }
-        file.environment.rotation_deg =
-            self.env_rotate_deg.unwrap_or(file.environment.rotation_deg);
-        file.environment.lights = self.env_lights.unwrap_or(file.environment.lights);
-        file.render.exposure = self.exposure.or(file.render.exposure);
-        file.render.irradiance_resolution = self
-            .irradiance_resolution
-            .unwrap_or(file.render.irradiance_resolution);
-        file.skin.occlusion = self.occlusion.unwrap_or(file.skin.occlusion);
-        file.skin.kernel = self.kernel.unwrap_or(file.skin.kernel);
-        file.skin.chain = self.chain.unwrap_or(file.skin.chain);
-        file.textures.uv_origin = self.uv_origin.unwrap_or(file.textures.uv_origin);
-        file.render.width = self.width.unwrap_or(file.render.width);
-        file.render.height = self.height.unwrap_or(file.render.height);
-        file.skin.blur_width = self.blur_width.unwrap_or(file.skin.blur_width);
-        file.skin.blur_amount = self.blur_amount.unwrap_or(file.skin.blur_amount);
-        file.textures.test_texture = self.test_texture.unwrap_or(file.textures.test_texture);
-        file.render.tone_curve = self.tone_curve.unwrap_or(file.render.tone_curve);
-        file.render.skybox = self.skybox.unwrap_or(file.render.skybox);
-        file.render.background = self.background.unwrap_or(file.render.background);
-        file.render.glow = self.glow.unwrap_or(file.render.glow);
-        file.render.glow_intensity = self.glow_intensity.unwrap_or(file.render.glow_intensity);
-        file.validate()
-            .map_err(|m| crate::Error::Input(format!("command line: {m}")))?;
-        Ok(file)
-    }
-}
 
 /// Where a light is.
 #[derive(Clone, Copy, Debug, PartialEq)]

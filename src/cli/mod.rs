@@ -1,0 +1,43 @@
+//! The commands of the `dermis` binary: one module per group, one function per
+//! command; `main.rs` parses and dispatches.
+
+pub mod compare;
+pub mod inspect;
+pub mod reference;
+pub mod render;
+pub mod sweep;
+pub mod view;
+
+use std::path::Path;
+
+/// Environment variables and exit codes, shown by every command's `--help`.
+pub const AFTER_HELP: &str = "\
+Environment:
+  DERMIS_DEVICE=SUBSTRING   device to use (as --device)
+  DERMIS_VALIDATION=1       Khronos validation + synchronization validation (as --validation)
+  DERMIS_CACHE_DIR=DIR      occlusion transfer cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
+  RUST_LOG=LEVEL            log filter (overrides -v)
+  LP_NUM_THREADS=N          lavapipe's rasterizer threads (recorded in reports)
+  DISPLAY                   the X display `dermis view` opens its window on
+
+Exit status:
+  0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver,
+  window system); compare and interleave with --fail-on-regression: 3 when a pass
+  regressed.";
+
+fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String> {
+    serde_json::to_string_pretty(value)
+        .map_err(|e| dermis::Error::Input(format!("{}: {e}", path.display())))
+}
+
+/// Whole or not at all: a temporary file renamed into place.
+fn write_file(path: &Path, text: &str) -> dermis::Result<()> {
+    dermis::atomic::write_atomic(path, text)
+}
+
+fn read_text(path: &Path) -> dermis::Result<String> {
+    std::fs::read_to_string(path).map_err(|source| dermis::Error::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}

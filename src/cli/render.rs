@@ -1,0 +1,183 @@
+//! `dermis render` and `dermis precompute`.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use clap::Args;
+use dermis::gpu::{Context, ContextOptions};
+use dermis::render::output::{write_sheet, Format};
+use dermis::render::{compare_occlusion, debug_sheet, render_scene, RenderOptions, View};
+use dermis::scene::{Overrides, Scene, SceneArg};
+
+use super::{to_json, write_file};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArg,
+    /// Output image: .png (8-bit sRGB) or .exr (linear float).
+    #[arg(long, default_value = "dermis.png")]
+    out: PathBuf,
+    #[command(flatten)]
+    overrides: Overrides,
+    /// What to write: a view with shading of its own (final, diffuse,
+    /// specular, direct, reference, occlusion, depth, normals, albedo,
+    /// regions, test-texture) or any image of the frame graph by name, as
+    /// stored (irradiance, stretch, stretch1…5, blur1…6, prefiltered, …).
+    /// `--view list` prints every view of the scene and exits.
+    #[arg(long, default_value = "final", value_name = "VIEW|list")]
+    view: View,
+    /// Also write the debug sheet (PNG): the stretch and blur levels (the
+    /// paper's Fig. 3), depth, occlusion and specular, labelled.
+    #[arg(long, value_name = "FILE.png")]
+    debug_sheet: Option<PathBuf>,
+    /// Also write --view with occlusion on and off side by side (PNG, one
+    /// exposure; the paper's Figs. 6–8).
+    #[arg(long, value_name = "FILE.png")]
+    compare_occlusion: Option<PathBuf>,
+    /// Frames to render per run (≥ 1); with more than one the first is warm-up.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Warm-up frames per run, outside the statistics (default: 1 when
+    /// --frames is more than 1, else 0).
+    #[arg(long)]
+    warmup: Option<u32>,
+    /// Independent repetitions, each with a fresh upload, pipelines and
+    /// warm-up, so that `dermis compare` has runs, not only frames of one
+    /// pipeline state; the image is the last run's.
+    #[arg(long, default_value_t = 1)]
+    runs: u32,
+    /// Print the per-pass GPU time table (median, min, max, p90 of measured frames).
+    #[arg(long)]
+    timings: bool,
+    /// Write the run report (setup, version, device, per-pass statistics, every
+    /// frame's pass times and starts, memory) as JSON.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Write the frames and passes as a Chrome trace (Perfetto, chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Write one CSV row per pass per frame, with the run's setup in each row.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Print the compiled render graph (passes, barriers, lifetimes).
+    #[arg(long)]
+    dump_graph: bool,
+    /// Also time two ruler passes at the irradiance resolution (an RGBA16F copy,
+    /// `ruler_copy`, and a read, `ruler_read`) and report every pass's ns/texel
+    /// as a multiple of the copy's (docs/performance.md).
+    #[arg(long)]
+    ruler: bool,
+}
+
+#[derive(Args)]
+pub struct PrecomputeArgs {
+    #[command(flatten)]
+    scene: SceneArg,
+    #[command(flatten)]
+    overrides: Overrides,
+}
+
+/// `dermis render`.
+pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> {
+    let file = args.scene.file()?;
+    let hdr = Format::of(&args.out)? == Format::Exr;
+    for path in [&args.debug_sheet, &args.compare_occlusion]
+        .into_iter()
+        .flatten()
+    {
+        Format::of(path)?;
+    }
+    let opts = RenderOptions {
+        frames: args.frames,
+        hdr,
+        view: args.view,
+        scene_path: Some(args.scene.path()),
+        progress: std::io::stderr().is_terminal(),
+        ruler: args.ruler,
+        runs: args.runs,
+        warmup: args.warmup,
+    };
+    opts.warmup_frames()?;
+    let loaded = Scene::load(args.overrides.apply(file)?)?;
+    let ctx = Context::new(context)?;
+    if opts.view.name() == "list" {
+        for name in dermis::render::views(&ctx, &loaded)? {
+            println!("{name}");
+        }
+        return Ok(());
+    }
+    let output = render_scene(&ctx, &loaded, &opts)?;
+    if args.dump_graph {
+        print!("{}", output.plan);
+    }
+    dermis::render::output::write(&args.out, &output)?;
+    if let Some(r) = &output.reference {
+        eprintln!(
+            "reference: {} mesh pixels, {:.1} % converged to 0.5 %, mean standard error \
+             {:.2} %, {:.0} directions per pixel, {:.1} s",
+            r.mesh_pixels,
+            100.0 * r.converged,
+            100.0 * r.mean_rel_std_err,
+            r.samples as f64 / f64::from(r.mesh_pixels.max(1)),
+            r.seconds
+        );
+    }
+    let r = &output.report;
+    if let Some(w) = r
+        .cold_warning()
+        .filter(|_| args.timings || args.report.is_some())
+    {
+        eprintln!("{w}");
+    }
+    if args.timings {
+        print!("{}{}", r.header(), r.table());
+    }
+    if let Some(path) = args.report {
+        write_file(&path, &to_json(&path, r)?)?;
+    }
+    if let Some(path) = args.trace {
+        write_file(&path, &to_json(&path, &dermis::profile::trace::trace(r))?)?;
+    }
+    if let Some(path) = args.csv {
+        write_file(&path, &dermis::profile::csv::csv(r))?;
+    }
+    println!(
+        "wrote {} (exposure {:+.2} EV, {})",
+        args.out.display(),
+        output.exposure,
+        if output.metered.is_some() {
+            "metered"
+        } else {
+            "given"
+        }
+    );
+    if let Some(path) = args.debug_sheet {
+        write_sheet(&path, &debug_sheet(&ctx, &loaded, &opts)?)?;
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = args.compare_occlusion {
+        write_sheet(&path, &compare_occlusion(&ctx, &loaded, &opts)?)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// `dermis precompute`.
+pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Result<()> {
+    let file = args.scene.load(&args.overrides)?;
+    let mesh = dermis::scene::load_mesh(&file)?;
+    let ctx = Context::new(context)?;
+    let started = std::time::Instant::now();
+    let t = dermis::light::occlusion::transfer_for(&ctx, &mesh, file.skin.occlusion)?;
+    let secs = started.elapsed().as_secs_f64();
+    println!(
+        "{} vertices, occlusion {:?}: {:.2} s ({:.1} µs per vertex), cache {}",
+        t.coeffs.len(),
+        file.skin.occlusion,
+        secs,
+        secs * 1e6 / t.coeffs.len().max(1) as f64,
+        dermis::light::occlusion::default_cache_dir().display()
+    );
+    Ok(())
+}
