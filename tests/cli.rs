@@ -597,8 +597,10 @@ fn views_write_intermediates() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
+    // Views are the frame graph's images: an unknown one is refused before
+    // any frame is rendered, naming how to list them.
     assert!(
-        stderr.contains("invalid value 'blur7' for '--view") && stderr.contains("blur6"),
+        stderr.contains("--view blur7: no such view") && stderr.contains("--view list"),
         "{stderr}"
     );
 }
@@ -758,5 +760,40 @@ fn help_documents_every_flag_the_environment_and_exit_codes() {
         "--env-lights",
     ] {
         assert!(help.contains(value), "render --help lacks {value}");
+    }
+}
+
+#[test]
+fn view_list_prints_every_view() {
+    let out = dermis(&[
+        "render",
+        "--view",
+        "list",
+        "--irradiance-res",
+        "256",
+        "--width",
+        "64",
+        "--height",
+        "80",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let listed = String::from_utf8_lossy(&out.stdout);
+    let names: Vec<&str> = listed.lines().collect();
+    for name in [
+        "final",
+        "depth",
+        "test-texture",
+        "irradiance",
+        "stretch",
+        "stretch5",
+    ] {
+        assert!(names.contains(&name), "{name} not in {names:?}");
+    }
+    for name in ["blur1", "blur6", "prefiltered"] {
+        assert!(names.contains(&name), "{name} not in {names:?}");
     }
 }

@@ -23,7 +23,8 @@ pub struct RenderArgs {
     /// What to write: a view with shading of its own (final, diffuse,
     /// specular, direct, reference, occlusion, depth, normals, albedo,
     /// regions, test-texture) or any image of the frame graph by name, as
-    /// stored (irradiance, stretch, stretch1…5, blur1…6, prefiltered, …).
+    /// stored (irradiance, stretch, stretch1…stretch5, blur1…blur6,
+    /// prefiltered, …).
     /// `--view list` prints every view of the scene and exits.
     #[arg(long, default_value = "final", value_name = "VIEW|list")]
     view: View,

@@ -305,14 +305,14 @@ impl Frame {
             skin.resolution
         );
         let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
-        let env = &scene.file.environment;
+        let (rotation, intensity) = (lighting.rotation_deg, lighting.intensity);
         let pipelines = Pipelines::new(ctx);
         Ok(Self {
             tables,
             passes: Passes::new(&pipelines, scene, &inputs, &lighting, &skin)?,
             pipelines,
             ruler,
-            sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, env.rotation_deg, env.intensity)?,
+            sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, rotation, intensity)?,
             inputs,
             lighting,
             weights: weights.try_into().unwrap_or([Vec3::ZERO; 6]),
