@@ -1,8 +1,9 @@
 //! Writing rendered images: PNG (8-bit, as tone-mapped) or EXR (linear float),
-//! by extension.
+//! by extension; each encoded in memory and written atomically (crate::atomic).
 
 use super::sheet::Sheet;
 use super::RenderOutput;
+use crate::atomic::write_atomic;
 use crate::error::{Error, Result};
 use std::path::Path;
 
@@ -34,7 +35,7 @@ impl Format {
 pub fn write(path: &Path, out: &RenderOutput) -> Result<()> {
     let (w, h) = (out.width, out.height);
     match Format::of(path)? {
-        Format::Png => write_png(path, w, h, &out.rgba8),
+        Format::Png => write_rgba8_png(path, w, h, &out.rgba8),
         Format::Exr => {
             let hdr = out.hdr.as_ref().ok_or_else(|| {
                 Error::Input(format!("{}: no HDR image was rendered", path.display()))
@@ -61,20 +62,32 @@ pub fn write_sheet(path: &Path, sheet: &Sheet) -> Result<()> {
             path.display()
         )));
     }
-    write_png(path, sheet.width, sheet.height, &sheet.rgba8)
+    write_rgba8_png(path, sheet.width, sheet.height, &sheet.rgba8)
 }
 
-fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba8, width, height, image::ExtendedColorType::Rgba8)
-        .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display())))
+/// Writes 8-bit RGBA (row-major, top row first) as a PNG, whole or not at all
+/// (crate::atomic): every PNG dermis writes, the viewer's screenshots included.
+pub fn write_rgba8_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
+    use image::ImageEncoder;
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(rgba8, width, height, image::ExtendedColorType::Rgba8)
+        .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display())))?;
+    write_atomic(path, png)
 }
 
-/// Linear RGBA f32, row-major, top row first.
+/// Linear RGBA f32, row-major, top row first, as EXR, whole or not at all.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> Result<()> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
     let w = width as usize;
-    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+    let channels = SpecificChannels::rgba(|Vec2(x, y)| {
         let i = (y * w + x) * 4;
         (rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3])
-    })
-    .map_err(|e| Error::Input(format!("{}: cannot write EXR: {e}", path.display())))
+    });
+    let mut exr = std::io::Cursor::new(Vec::new());
+    Image::from_channels((w, height as usize), channels)
+        .write()
+        .to_buffered(&mut exr)
+        .map_err(|e| Error::Input(format!("{}: cannot write EXR: {e}", path.display())))?;
+    write_atomic(path, exr.into_inner())
 }

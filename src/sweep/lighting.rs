@@ -16,7 +16,7 @@ use crate::light::reference::{render_view, Settings};
 use crate::post::meter;
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::render::output::write_exr;
+use crate::render::output::{write_exr, write_rgba8_png};
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::env::EnvSource;
 use crate::scene::file::{LightsMode, SceneFile};
@@ -136,15 +136,7 @@ pub fn run(
                         .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
                 })
                 .collect();
-            let path = name("reference-sh9-lights.png");
-            image::save_buffer(
-                &path,
-                &side_by_side,
-                3 * w,
-                h,
-                image::ExtendedColorType::Rgba8,
-            )
-            .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display())))?;
+            write_rgba8_png(&name("reference-sh9-lights.png"), 3 * w, h, &side_by_side)?;
         }
         progress(&row);
         rows.push(row);

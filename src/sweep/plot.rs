@@ -3,8 +3,9 @@
 //! point as stacked bars.
 
 use super::{name, Point, Sweep};
-use crate::atomic::{commit, temporary};
+use crate::atomic::write_atomic;
 use crate::error::{Error, Result};
+use crate::render::output::write_rgba8_png;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -20,22 +21,30 @@ pub fn write_plots(sweep: &Sweep, dir: &Path) -> Result<()> {
     // Registering twice is harmless; the bitmap backend looks fonts up by family.
     plotters::style::register_font("sans-serif", FontStyle::Normal, crate::text::FONT)
         .map_err(|_| plot_error(dir, "the embedded font does not load"))?;
-    // Each drawn under a temporary name (same extension) and renamed into place.
+    // Each drawn in memory and written whole (crate::atomic).
     for stem in ["time_vs_error", "passes"] {
         let svg = dir.join(format!("{stem}.svg"));
-        let tmp = temporary(&svg);
-        draw(sweep, stem, SVGBackend::new(&tmp, SIZE).into_drawing_area())
-            .map_err(|e| plot_error(&svg, e))?;
-        commit(&tmp, &svg)?;
-        let png = dir.join(format!("{stem}.png"));
-        let tmp = temporary(&png);
+        let mut text = String::new();
         draw(
             sweep,
             stem,
-            BitMapBackend::new(&tmp, SIZE).into_drawing_area(),
+            SVGBackend::with_string(&mut text, SIZE).into_drawing_area(),
+        )
+        .map_err(|e| plot_error(&svg, e))?;
+        write_atomic(&svg, text)?;
+        let png = dir.join(format!("{stem}.png"));
+        let mut rgb = vec![0u8; 3 * (SIZE.0 * SIZE.1) as usize];
+        draw(
+            sweep,
+            stem,
+            BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area(),
         )
         .map_err(|e| plot_error(&png, e))?;
-        commit(&tmp, &png)?;
+        let rgba: Vec<u8> = rgb
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect();
+        write_rgba8_png(&png, SIZE.0, SIZE.1, &rgba)?;
     }
     Ok(())
 }

@@ -180,23 +180,18 @@ pub fn load_cached(dir: &Path, key: &str) -> Option<Transfer> {
     }
 }
 
-/// Writes `<dir>/<key>.transfer` (creating `dir`), via a temporary file and a
-/// rename so readers never see a partial file. Format, little endian:
+/// Writes `<dir>/<key>.transfer` (creating `dir`) atomically (crate::atomic):
+/// readers never see a partial file, a failed write leaves no temporary. Format, little endian:
 /// `"DRMSTRNS"`, u32 version (1), u32 key length, key bytes, u64 vertex count,
 /// `9 × count` f32 coefficients, then the u64 FNV-1a of all preceding bytes.
-pub fn store_cached(dir: &Path, key: &str, t: &Transfer) -> std::io::Result<()> {
-    let path = cache_path(dir, key).ok_or_else(|| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!("invalid cache key {key:?}"),
-        )
+pub fn store_cached(dir: &Path, key: &str, t: &Transfer) -> crate::Result<()> {
+    let path = cache_path(dir, key)
+        .ok_or_else(|| crate::Error::Input(format!("invalid cache key {key:?}")))?;
+    std::fs::create_dir_all(dir).map_err(|source| crate::Error::Io {
+        path: dir.display().to_string(),
+        source,
     })?;
-    std::fs::create_dir_all(dir)?;
-    let tmp = dir.join(format!("{key}.transfer.tmp{}", std::process::id()));
-    std::fs::write(&tmp, encode(key, t))?;
-    std::fs::rename(&tmp, &path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+    crate::atomic::write_atomic(&path, encode(key, t))
 }
 
 #[cfg(test)]
@@ -257,6 +252,25 @@ mod tests {
         let empty = Transfer { coeffs: Vec::new() };
         store_cached(&dir, "empty", &empty).unwrap();
         assert_eq!(load_cached(&dir, "empty"), Some(empty));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_failed_store_leaves_no_temporary() {
+        let dir =
+            std::env::temp_dir().join(format!("dermis-occlusion-fail-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        // The entry's name is taken by a non-empty folder: the rename fails.
+        std::fs::create_dir_all(dir.join("k.transfer/x")).unwrap();
+        let t = Transfer {
+            coeffs: vec![[0.5; 9]; 4],
+        };
+        assert!(store_cached(&dir, "k", &t).is_err());
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["k.transfer"]);
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
