@@ -300,6 +300,99 @@ fn unknown_output_format_is_a_clean_error() {
     );
 }
 
+/// Every output is checked before any work: with a device that does not
+/// exist, the error is still the output's, so the device was never opened.
+/// Nothing is created.
+#[test]
+fn bad_outputs_are_refused_before_the_device_is_opened() {
+    let folder = tmp("a-folder.json");
+    std::fs::create_dir_all(&folder).unwrap();
+    let file = tmp("a-file.txt");
+    std::fs::write(&file, "x").unwrap();
+    let (folder, file) = (folder.to_str().unwrap(), file.to_str().unwrap());
+    let (sheet, shot, csv) = (tmp("sheet.exr"), tmp("shot.jpg"), tmp("c.txt"));
+    let (sheet, shot, csv) = (
+        sheet.to_str().unwrap(),
+        shot.to_str().unwrap(),
+        csv.to_str().unwrap(),
+    );
+    let cases: Vec<(Vec<&str>, &str, &str)> = vec![
+        (
+            vec!["render", "--report", "/no/such/dir/r.json"],
+            "--report",
+            "does not exist",
+        ),
+        (
+            vec!["render", "--out", "/no/such/dir/x.png"],
+            "--out",
+            "does not exist",
+        ),
+        (
+            vec!["render", "--debug-sheet", sheet],
+            "--debug-sheet",
+            "use .png)",
+        ),
+        (
+            vec!["render", "--compare-occlusion", sheet],
+            "--compare-occlusion",
+            "use .png)",
+        ),
+        (vec!["render", "--trace", folder], "--trace", "is a folder"),
+        (vec!["render", "--csv", csv], "--csv", "use .csv)"),
+        (vec!["sweep", "--out-dir", file], "--out-dir", "is a file"),
+        (
+            vec!["reference", "--out-dir", file],
+            "--out-dir",
+            "is a file",
+        ),
+        (
+            vec!["view", "--screenshot", shot],
+            "--screenshot",
+            "use .png)",
+        ),
+        (
+            vec!["interleave", "--runs", "1", "--out-dir", file],
+            "--out-dir",
+            "is a file",
+        ),
+        (
+            vec!["compare", "no-base.json", "no-new.json", "--junit", csv],
+            "--junit",
+            "use .xml)",
+        ),
+        (
+            vec!["export", "no-report.json", "--bencher", folder],
+            "--bencher",
+            "is a folder",
+        ),
+    ];
+    for (args, flag, why) in cases {
+        let path = args.last().copied().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+            .args(&args)
+            .args(["--device", "no-such-gpu-xyz"])
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("dermis runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        let line = stderr
+            .lines()
+            .find(|l| l.starts_with("error:"))
+            .unwrap_or_default();
+        assert!(
+            line.contains(&format!("{flag} {path}")) && line.contains(why),
+            "{args:?}: {stderr}"
+        );
+        assert!(!stderr.contains("no-such-gpu-xyz"), "{args:?}: {stderr}");
+    }
+    for created in [sheet, shot, csv] {
+        assert!(!std::path::Path::new(created).exists(), "{created}");
+    }
+    assert!(!std::path::Path::new("/no/such/dir").exists());
+}
+
 #[test]
 fn unknown_device_is_a_clean_error() {
     let out = dermis(&["info", "--device", "no-such-gpu-xyz"]);

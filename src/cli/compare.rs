@@ -8,7 +8,7 @@ use clap::Args;
 use dermis::profile::compare::{self, Comparison, Measurement};
 use dermis::sweep::compare::{self as input, Side};
 
-use super::{read_text, to_json, write_file};
+use super::{check_out_dir, check_output, read_text, to_json, write_file};
 
 /// How `compare` and `interleave` decide and what they write.
 #[derive(Args)]
@@ -91,8 +91,18 @@ pub struct ExportArgs {
     bencher: Option<PathBuf>,
 }
 
+impl DecideArgs {
+    fn check_outputs(&self) -> dermis::Result<()> {
+        match &self.junit {
+            Some(path) => check_output("--junit", path, &["xml"]),
+            None => Ok(()),
+        }
+    }
+}
+
 /// `dermis compare`: two reports (or folders of them), or two sweeps point by point.
 pub fn compare(args: CompareArgs) -> dermis::Result<ExitCode> {
+    args.decide.check_outputs()?;
     match (input::load(&args.base)?, input::load(&args.new)?) {
         (Side::Runs(base, w1), Side::Runs(new, w2)) => report_comparison(
             &[(String::new(), *base, *new)],
@@ -122,6 +132,8 @@ pub fn compare(args: CompareArgs) -> dermis::Result<ExitCode> {
 
 /// `dermis interleave`.
 pub fn interleave(args: InterleaveArgs) -> dermis::Result<ExitCode> {
+    args.decide.check_outputs()?;
+    check_out_dir("--out-dir", &args.out_dir)?;
     let me = std::env::current_exe().map_err(|source| dermis::Error::Io {
         path: "the running dermis binary".into(),
         source,
@@ -149,6 +161,14 @@ pub fn export(args: ExportArgs) -> dermis::Result<()> {
         return Err(dermis::Error::Input(
             "export: give --github-benchmark FILE or --bencher FILE".into(),
         ));
+    }
+    for (flag, path) in [
+        ("--github-benchmark", &args.github_benchmark),
+        ("--bencher", &args.bencher),
+    ] {
+        if let Some(path) = path {
+            check_output(flag, path, &["json"])?;
+        }
     }
     let text = read_text(&args.report)?;
     let r: dermis::profile::RunReport = serde_json::from_str(&text).map_err(|e| {

@@ -71,6 +71,9 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
         overrides,
         envs,
     } = args.scene;
+    if let Some(dir) = &args.out_dir {
+        super::check_out_dir("--out-dir", dir)?;
+    }
     let file = scene.load(&overrides)?;
     let environments = if envs.is_empty() {
         vec![file.environment.source.clone()]

@@ -9,7 +9,7 @@ use dermis::render::output::{write_sheet, Format};
 use dermis::render::{compare_occlusion, debug_sheet, render_scene, RenderOptions, View};
 use dermis::scene::{Overrides, Scene, SceneArg};
 
-use super::{to_json, write_file};
+use super::{check_output, to_json, write_file};
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -81,14 +81,20 @@ pub struct PrecomputeArgs {
 
 /// `dermis render`.
 pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> {
+    check_output("--out", &args.out, &["png", "exr"])?;
+    for (flag, path, exts) in [
+        ("--debug-sheet", &args.debug_sheet, &["png"][..]),
+        ("--compare-occlusion", &args.compare_occlusion, &["png"]),
+        ("--report", &args.report, &["json"]),
+        ("--trace", &args.trace, &["json"]),
+        ("--csv", &args.csv, &["csv"]),
+    ] {
+        if let Some(path) = path {
+            check_output(flag, path, exts)?;
+        }
+    }
     let file = args.scene.file()?;
     let hdr = Format::of(&args.out)? == Format::Exr;
-    for path in [&args.debug_sheet, &args.compare_occlusion]
-        .into_iter()
-        .flatten()
-    {
-        Format::of(path)?;
-    }
     let opts = RenderOptions {
         frames: args.frames,
         hdr,

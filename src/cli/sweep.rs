@@ -8,7 +8,7 @@ use dermis::scene::file::{Chain, Kernel};
 use dermis::scene::{Overrides, SceneArg};
 use dermis::sweep::{self as sw, output};
 
-use super::{to_json, AFTER_HELP};
+use super::{check_out_dir, to_json, AFTER_HELP};
 
 #[derive(Args)]
 #[command(
@@ -105,6 +105,7 @@ pub fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
     if let Some(SweepCommand::Merge(merge_args)) = args.command {
         return merge(merge_args);
     }
+    check_out_dir("--out-dir", &args.out_dir)?;
     if args.replot {
         let sweep = sw::load(&args.out_dir.join("sweep.json"))?;
         output::write_csv_and_plots(&sweep, &args.out_dir)?;
@@ -206,6 +207,9 @@ fn list_points(
 
 /// `dermis sweep merge`.
 fn merge(args: MergeArgs) -> dermis::Result<()> {
+    if let Some(dir) = &args.out_dir {
+        check_out_dir("--out-dir", dir)?;
+    }
     let merged = sw::merge::merge(
         &args.inputs,
         sw::merge::MergeOptions {

@@ -26,6 +26,9 @@ pub fn view(args: ViewArgs, context: ContextOptions) -> dermis::Result<()> {
     if args.frames == Some(0) {
         return Err(dermis::Error::Input("--frames 0: give 1 or more".into()));
     }
+    if let Some(path) = &args.screenshot {
+        super::check_output("--screenshot", path, &["png"])?;
+    }
     dermis::viewer::run(dermis::viewer::ViewerOptions {
         scene: args.scene.load(&args.overrides)?,
         scene_path: args.scene.scene,

@@ -1,8 +1,8 @@
 //! Glow (bloom) on the HDR image, d'Eon & Luebke's (GPU Gems 3 ch. 14): the
 //! film/eye falloff (1 − r/d)⁴ of Pharr & Humphreys' bloom (Physically Based
 //! Rendering, 2004) approximated as a sum of two Gaussians, 0.0174·G(0.008, r) +
-//! 0.192·G(0.0576, r) with G(v, r) = exp(−r²/2v)/(2πv) (constants as the design
-//! card, shared/ARCHITECTURE.md, gives them). The fit is to the falloff with
+//! 0.192·G(0.0576, r) with G(v, r) = exp(−r²/2v)/(2πv) (constants from the
+//! project's design card). The fit is to the falloff with
 //! d = 1: it integrates to 0.2094 = 2π/30, the integral of (1 − r)⁴ over the
 //! disc, and meets it at r = 0.2 and 0.5 within 0.01. dermis takes d = the image
 //! height: r and √v are fractions of the height, so the glow keeps its look

@@ -8,7 +8,7 @@ use super::{in_range, non_negative, positive};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Kernel {
-    /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in ARCHITECTURE.md).
+    /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in docs/skin.md, "Blur kernels").
     Deon7,
     /// Wider, exactly normalised Gaussian taps (reference quality).
     Accurate,

@@ -33,6 +33,16 @@ const GLTF_MM_PER_UNIT: f32 = 1000.0;
 /// outside this range the unit scale is probably wrong.
 const PLAUSIBLE_HEAD_MM: std::ops::RangeInclusive<f32> = 100.0..=1000.0;
 
+/// `x` in plain notation with at least three significant digits (0.000123,
+/// 50.3, 12456): a scale hint for a huge mesh must not round to 0.000.
+fn significant3(x: f32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return x.to_string();
+    }
+    let magnitude = (x.abs().log10().floor() as i32).clamp(-30, 30);
+    format!("{x:.0$}", (2 - magnitude).max(0) as usize)
+}
+
 /// Refuse accessors with more elements than this (bounds memory on hostile input).
 const MAX_ELEMENTS: usize = 1 << 26;
 
@@ -83,13 +93,14 @@ pub fn load_mesh_from_slice(
         let extent = (hi - lo).max_element();
         if !PLAUSIBLE_HEAD_MM.contains(&extent) {
             log::warn!(
-                "{}: the mesh is {extent:.0} mm across at {scale} mm per unit, implausible for \
-                 a head ({}..{} mm); set mm_per_unit (about {:.3} would make it 250 mm; the \
-                 Lee Perry-Smith scan needs 50.3)",
+                "{}: the mesh is {} mm across at {scale} mm per unit, implausible for a head \
+                 ({}..{} mm); set mm_per_unit (about {} would make it 250 mm; the Lee \
+                 Perry-Smith scan needs 50.3)",
                 path.display(),
+                significant3(extent),
                 PLAUSIBLE_HEAD_MM.start(),
                 PLAUSIBLE_HEAD_MM.end(),
-                scale * 250.0 / extent.max(f32::MIN_POSITIVE),
+                significant3(scale * 250.0 / extent.max(f32::MIN_POSITIVE)),
             );
         }
     }
@@ -211,6 +222,14 @@ mod tests {
     use super::buffers::{decode_base64, percent_decode};
     use super::tangents::face_cross;
     use super::*;
+
+    #[test]
+    fn scale_hints_keep_three_significant_digits() {
+        assert_eq!(significant3(0.000_123_4), "0.000123");
+        assert_eq!(significant3(50.31), "50.3");
+        assert_eq!(significant3(12456.0), "12456");
+        assert_eq!(significant3(0.0), "0");
+    }
     use std::path::PathBuf;
 
     fn lee_perry_smith() -> PathBuf {
