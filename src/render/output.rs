@@ -69,6 +69,7 @@ pub fn write_sheet(path: &Path, sheet: &Sheet) -> Result<()> {
 /// (crate::atomic): every PNG dermis writes, the viewer's screenshots included.
 pub fn write_rgba8_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
     use image::ImageEncoder;
+    check_size(path, rgba8.len(), width, height)?;
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)
         .write_image(rgba8, width, height, image::ExtendedColorType::Rgba8)
@@ -76,9 +77,21 @@ pub fn write_rgba8_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Re
     write_atomic(path, png)
 }
 
+/// `len` values are RGBA of `width` × `height` pixels (the encoders panic else).
+fn check_size(path: &Path, len: usize, width: u32, height: u32) -> Result<()> {
+    if len == 4 * width as usize * height as usize {
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "{}: {len} values are not the RGBA of {width} × {height} pixels",
+        path.display()
+    )))
+}
+
 /// Linear RGBA f32, row-major, top row first, as EXR, whole or not at all.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> Result<()> {
     use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    check_size(path, rgba.len(), width, height)?;
     let w = width as usize;
     let channels = SpecificChannels::rgba(|Vec2(x, y)| {
         let i = (y * w + x) * 4;
@@ -90,4 +103,40 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> Result<(
         .to_buffered(&mut exr)
         .map_err(|e| Error::Input(format!("{}: cannot write EXR: {e}", path.display())))?;
     write_atomic(path, exr.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_round_trip_and_a_refused_write_keeps_the_old_file() {
+        let d = std::env::temp_dir().join(format!("dermis-output-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        let (png, exr) = (d.join("a.png"), d.join("a.exr"));
+        let rgba8 = [10, 20, 30, 255, 40, 50, 60, 128];
+        write_rgba8_png(&png, 2, 1, &rgba8).unwrap();
+        assert_eq!(image::open(&png).unwrap().to_rgba8().into_raw(), rgba8);
+        write_exr(&exr, 1, 2, &[0.5, 1.0, 2.0, 1.0, 3.0, 4.0, 5.0, 0.25]).unwrap();
+        let back = exr::prelude::read_first_rgba_layer_from_file(
+            &exr,
+            |_, _| Vec::new(),
+            |px: &mut Vec<[f32; 4]>, _, (r, g, b, a): (f32, f32, f32, f32)| px.push([r, g, b, a]),
+        )
+        .unwrap();
+        let px = &back.layer_data.channel_data.pixels;
+        assert_eq!(px, &[[0.5, 1.0, 2.0, 1.0], [3.0, 4.0, 5.0, 0.25]]);
+        let old = std::fs::read(&png).unwrap();
+        // Too few pixels for the size: refused before anything is written.
+        assert!(write_rgba8_png(&png, 4, 4, &rgba8).is_err());
+        assert_eq!(std::fs::read(&png).unwrap(), old);
+        let mut names: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["a.exr", "a.png"]);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 }
