@@ -137,8 +137,11 @@ pub fn show(
     timings: &Timings,
 ) -> (bool, egui::Rect) {
     let mut screenshot = false;
+    // At most half the window: the frame beside it never shrinks to nothing.
+    let most = 0.5 * ui.max_rect().width();
     egui::Panel::left("controls")
         .default_size(270.0)
+        .size_range(egui::Rangef::new(0.0, most.max(0.0)))
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.heading("dermis");
