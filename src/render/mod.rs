@@ -295,7 +295,7 @@ fn single(opts: &RenderOptions) -> RenderOptions {
     }
 }
 
-/// The debug sheet: every view of [`SHEET_VIEWS`] rendered (one frame each, on
+/// The debug sheet: every view of [`sheet_views`] rendered (one frame each, on
 /// one upload of the scene) and labelled with its name.
 pub fn debug_sheet(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<Sheet> {
     let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
