@@ -919,3 +919,34 @@ fn a_validation_message_fails_the_run() {
     );
     assert_eq!(count, 1);
 }
+
+/// The CPU reference says how far it is (plain lines: stderr is no terminal)
+/// and how well it converged.
+#[test]
+fn the_cpu_reference_reports_progress_and_convergence() {
+    let png = tmp("reference.png");
+    let out = dermis(&[
+        "render",
+        "--scene",
+        "builtin",
+        "--view",
+        "reference",
+        "--width",
+        "24",
+        "--height",
+        "20",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for line in [
+        "reference: started",
+        "reference: 50 % (10/20)",
+        "left",
+        "reference: done in",
+    ] {
+        assert!(stderr.contains(line), "{line}: {stderr}");
+    }
+    assert!(stderr.contains("converged to 0.5 %"), "{stderr}");
+}

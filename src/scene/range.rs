@@ -8,10 +8,8 @@
 //! shading's targets hold sums of such terms (diffuse and specular, a highlight
 //! that exceeds its light's irradiance), so the bound × [`SHADING_HEADROOM`]
 //! must stay within [`HALF_MAX`]. The skybox shows the map's radiance ×
-//! intensity as it is: its brightest texel beyond [`HALF_MAX`] is a warning (it
-//! may lie outside the view), not an error.
-
-use glam::Vec3;
+//! intensity as it is: texels beyond [`HALF_MAX`] (the built-in sky's sun)
+//! saturate there, as a sun should; `-v` logs it.
 
 use super::env::{texel_solid_angle_f64, EnvMap, HALF_MAX};
 use super::file::SceneFile;
@@ -59,7 +57,7 @@ fn light_peak(light: &Light, mesh: &Mesh) -> f64 {
 }
 
 /// Refuses a scene whose lighting may overflow the half-float targets (module
-/// doc); warns when the skybox's brightest texel would.
+/// doc); logs (info) when the skybox's brightest texel would.
 pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> Result<(), String> {
     let budget = f64::from(HALF_MAX) / SHADING_HEADROOM;
     let intensity = f64::from(file.environment.intensity);
@@ -68,7 +66,7 @@ pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> R
     let from_lights: f64 = per_light.iter().sum();
     let total = intensity * integral + from_lights;
     if file.render.skybox && intensity * peak > f64::from(HALF_MAX) {
-        log::warn!(
+        log::info!(
             "environment: its brightest texel ({peak:.4e}) × environment.intensity ({intensity}) \
              exceeds half-float's {HALF_MAX}: the skybox saturates there"
         );
@@ -107,6 +105,7 @@ pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     #[test]
     fn a_uniform_map_integrates_to_four_pi() {
@@ -134,9 +133,10 @@ mod tests {
             ..Mesh::default()
         };
         let env = EnvMap::uniform(Vec3::ONE, 64, 32);
-        let mut file = SceneFile::default();
-        file.lights =
-            vec![toml::from_str("kind = \"directional\"\ndirection = [0, -1, 0]").unwrap()];
+        let mut file = SceneFile {
+            lights: vec![toml::from_str("kind = \"directional\"\ndirection = [0, -1, 0]").unwrap()],
+            ..SceneFile::default()
+        };
         let sun = [light(LightSource::Directional(Vec3::Y), 1.0)];
         assert!(check(&file, &env, &sun, &mesh).is_ok());
 
