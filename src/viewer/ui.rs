@@ -38,8 +38,7 @@ pub struct Controls {
 pub fn environments(scene_env: &EnvSource) -> Vec<(String, EnvSource)> {
     let mut out = vec![("scene's".to_string(), scene_env.clone())];
     for name in crate::assets::ENV_MAPS {
-        let path = crate::assets::path(&format!("env/{name}"));
-        if path.is_file() {
+        if let Ok(path) = crate::assets::find(&format!("env/{name}")) {
             out.push((name.to_string(), EnvSource::File(path)));
         }
     }
