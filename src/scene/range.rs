@@ -3,10 +3,9 @@
 //! largest intensity that works.
 //!
 //! The bound: the irradiance any surface can receive is at most the map's
-//! radiance integrated over the whole sphere, × `environment.intensity`, plus
-//! every light's irradiance (a point light's at its nearest vertex). The
-//! shading's targets hold sums of such terms (diffuse and specular, a highlight
-//! that exceeds its light's irradiance), so the bound × [`SHADING_HEADROOM`]
+//! largest cosine-weighted irradiance over all normals, × `environment.intensity`,
+//! plus every light's irradiance (a point light's at its nearest vertex). The
+//! targets hold about that irradiance at most, so it × [`SHADING_HEADROOM`]
 //! must stay within [`HALF_MAX`]. The skybox shows the map's radiance ×
 //! intensity as it is: texels beyond [`HALF_MAX`] (the built-in sky's sun)
 //! saturate there, as a sun should; `-v` logs it.
@@ -16,26 +15,62 @@ use super::file::SceneFile;
 use super::mesh::Mesh;
 use super::{Light, LightSource, POINT_LIGHT_REFERENCE_MM};
 
-/// Factor between the irradiance bound and what the shading may write: diffuse
-/// plus specular, and a specular peak of up to about twice the irradiance
-/// (KS lobe at the skin's roughness), with room to spare.
-pub const SHADING_HEADROOM: f64 = 4.0;
+/// Factor between the irradiance bound and what the targets may hold: the
+/// irradiance texture and the blur levels hold E × albedo^mix ≤ E, the screen
+/// radiance E/π × albedo plus the specular term, whose KS lobe can rise above
+/// E/π at grazing angles; 2 leaves room for it.
+pub const SHADING_HEADROOM: f64 = 2.0;
 
-/// The map's brightest channel value and its radiance integrated over the
-/// sphere (largest channel), before `environment.intensity`.
+/// Cells of the grid the map is binned into for [`env_peaks`], and normals tried.
+const GRID: (usize, usize) = (64, 32);
+const NORMALS: usize = 1024;
+/// For normals between those tried (≤ 3.5° from one: cos ≥ 0.998) and texels
+/// within half a cell (≤ 2.9°) of their cell's centre.
+const MARGIN: f64 = 1.01;
+
+/// The map's brightest channel value, and the largest irradiance (channel) it
+/// gives any surface, before `environment.intensity`: the largest over normals
+/// n of ∫ L(ω) max(0, n·ω) dω, the map binned into a grid of cells and n tried
+/// over a Fibonacci sphere, plus [`MARGIN`].
 pub fn env_peaks(env: &EnvMap) -> (f64, f64) {
-    let (mut peak, mut sum) = (0.0f64, [0.0f64; 3]);
+    let (gw, gh) = GRID;
+    let mut cells = vec![[0.0f64; 3]; gw * gh];
+    let mut peak = 0.0f64;
     for y in 0..env.height {
         let sr = texel_solid_angle_f64(y, env.width, env.height);
-        let row = &env.texels[(y * env.width) as usize..((y + 1) * env.width) as usize];
-        for t in row {
+        let cy = y as usize * gh / env.height as usize;
+        for x in 0..env.width {
+            let t = env.texels[(y * env.width + x) as usize];
             peak = peak.max(f64::from(t.max_element()));
-            for (s, c) in sum.iter_mut().zip(t.to_array()) {
+            let cell = &mut cells[cy * gw + x as usize * gw / env.width as usize];
+            for (s, c) in cell.iter_mut().zip(t.to_array()) {
                 *s += f64::from(c) * sr;
             }
         }
     }
-    (peak, sum.into_iter().fold(0.0, f64::max))
+    let centre = |i: usize| {
+        let (u, v) = ((i % gw) as f32 + 0.5, (i / gw) as f32 + 0.5);
+        super::env::direction(u / gw as f32, v / gh as f32)
+    };
+    let dirs: Vec<glam::Vec3> = (0..cells.len()).map(centre).collect();
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut most = 0.0f64;
+    for k in 0..NORMALS {
+        let z = 1.0 - 2.0 * (k as f64 + 0.5) / NORMALS as f64;
+        let (r, phi) = ((1.0 - z * z).sqrt(), golden * k as f64);
+        let n = glam::DVec3::new(r * phi.cos(), z, r * phi.sin());
+        let mut e = [0.0f64; 3];
+        for (cell, d) in cells.iter().zip(&dirs) {
+            let c = n.dot(d.as_dvec3());
+            if c > 0.0 {
+                for (e, v) in e.iter_mut().zip(cell) {
+                    *e += v * c;
+                }
+            }
+        }
+        most = most.max(e.into_iter().fold(0.0, f64::max));
+    }
+    (peak, most * MARGIN)
 }
 
 /// A light's largest irradiance channel on the mesh (unshadowed, a point light
@@ -61,10 +96,10 @@ fn light_peak(light: &Light, mesh: &Mesh) -> f64 {
 pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> Result<(), String> {
     let budget = f64::from(HALF_MAX) / SHADING_HEADROOM;
     let intensity = f64::from(file.environment.intensity);
-    let (peak, integral) = env_peaks(env);
+    let (peak, env_irradiance) = env_peaks(env);
     let per_light: Vec<f64> = lights.iter().map(|l| light_peak(l, mesh)).collect();
     let from_lights: f64 = per_light.iter().sum();
-    let total = intensity * integral + from_lights;
+    let total = intensity * env_irradiance + from_lights;
     if file.render.skybox && intensity * peak > f64::from(HALF_MAX) {
         log::info!(
             "environment: its brightest texel ({peak:.4e}) × environment.intensity ({intensity}) \
@@ -75,12 +110,12 @@ pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> R
         return Ok(());
     }
     let fmt = |v: f64| format!("{:.4e}", v.max(0.0));
-    let largest = if intensity * integral >= from_lights {
+    let largest = if intensity * env_irradiance >= from_lights {
         let rest = budget - from_lights;
         format!(
-            "environment.intensity = {intensity} (the map integrates to {}): at most {} works",
-            fmt(integral),
-            fmt(rest / integral)
+            "environment.intensity = {intensity} (the map gives at most {} of irradiance): at most {} works",
+            fmt(env_irradiance),
+            fmt(rest / env_irradiance)
         )
     } else {
         let (i, own) =
@@ -97,7 +132,7 @@ pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> R
     };
     Err(format!(
         "{largest}; the lighting would reach an irradiance of {} on the mesh, beyond \
-         {HALF_MAX} (half-float targets) / {SHADING_HEADROOM} (headroom for the shading's sums)",
+         {HALF_MAX} (half-float targets) / {SHADING_HEADROOM} (headroom for the specular term)",
         fmt(total)
     ))
 }
@@ -108,13 +143,12 @@ mod tests {
     use glam::Vec3;
 
     #[test]
-    fn a_uniform_map_integrates_to_four_pi() {
-        let (peak, integral) = env_peaks(&EnvMap::uniform(Vec3::new(2.0, 1.0, 0.5), 64, 32));
+    fn a_uniform_map_gives_pi_times_its_radiance() {
+        // ∫ L max(0, n·ω) dω = π L for a uniform map, whatever the normal.
+        let (peak, e) = env_peaks(&EnvMap::uniform(Vec3::new(2.0, 1.0, 0.5), 64, 32));
         assert_eq!(peak, 2.0);
-        assert!(
-            (integral - 8.0 * std::f64::consts::PI).abs() < 1e-9,
-            "{integral}"
-        );
+        let want = 2.0 * std::f64::consts::PI * MARGIN;
+        assert!((e - want).abs() < 0.01 * want, "{e} against {want}");
     }
 
     fn light(source: LightSource, irradiance: f32) -> Light {
@@ -140,11 +174,11 @@ mod tests {
         let sun = [light(LightSource::Directional(Vec3::Y), 1.0)];
         assert!(check(&file, &env, &sun, &mesh).is_ok());
 
-        // 4π × intensity × 4 > 65504 from intensity ≈ 1303.
-        file.environment.intensity = 2000.0;
+        // (π × 1.01 × intensity + 1) × 2 > 65504 from intensity ≈ 1.032e4.
+        file.environment.intensity = 3e4;
         let e = check(&file, &env, &sun, &mesh).unwrap_err();
         assert!(
-            e.starts_with("environment.intensity = 2000") && e.contains("at most 1.30"),
+            e.starts_with("environment.intensity = 30000") && e.contains("at most 1.03"),
             "{e}"
         );
         file.environment.intensity = 1.0;
@@ -158,7 +192,7 @@ mod tests {
         )
         .unwrap_err();
         assert!(
-            e.starts_with("lights[0].intensity = 1000000") && e.contains("at most 1.63"),
+            e.starts_with("lights[0].intensity = 1000000") && e.contains("at most 3.27"),
             "{e}"
         );
 
