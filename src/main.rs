@@ -20,7 +20,8 @@ struct Cli {
     /// Use the first Vulkan device whose name contains this (case-insensitive).
     #[arg(long, global = true, env = "DERMIS_DEVICE")]
     device: Option<String>,
-    /// Enable the Khronos validation layer with synchronization validation.
+    /// Enable the Khronos validation layer with synchronization validation; any
+    /// message it reports fails the run (exit status 4).
     #[arg(long, global = true, env = "DERMIS_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
     /// More log output (-v info, -vv debug); RUST_LOG overrides.
@@ -116,13 +117,22 @@ fn main() -> ExitCode {
     };
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level)).init();
     match run(cli) {
-        Ok(code) => code,
+        Ok(code) => match dermis::gpu::validation_messages() {
+            0 => code,
+            n => {
+                eprintln!("error: the validation layer reported {n} message(s) (above)");
+                ExitCode::from(VALIDATION_FAILED)
+            }
+        },
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(e.exit_code() as u8)
         }
     }
 }
+
+/// Exit status of a run that succeeded but drew validation messages (--validation).
+const VALIDATION_FAILED: u8 = 4;
 
 fn run(cli: Cli) -> dermis::Result<ExitCode> {
     let mut context = ContextOptions::from_env();

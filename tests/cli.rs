@@ -760,6 +760,87 @@ fn lights_prints_the_sun_of_the_sky() {
 }
 
 #[test]
+fn sh_and_lights_refuse_a_rotation_that_is_not_finite() {
+    for command in ["sh", "lights"] {
+        for value in ["nan", "inf", "-inf"] {
+            let out = dermis(&[command, "uniform:1", "--rotate", value]);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{command} {value}: {stderr}");
+            assert!(stderr.contains("--rotate"), "{stderr}");
+            assert!(out.stdout.is_empty(), "{command} {value}");
+        }
+    }
+}
+
+/// The binary copied into an empty folder (as `cargo install` or a CI artifact
+/// leaves it) and run from there, without the build's checkout to fall back on.
+#[test]
+fn a_binary_outside_its_checkout_finds_assets_or_says_where_it_looked() {
+    let dir = tmp("installed");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("bin")).unwrap();
+    let exe = dir.join("bin/dermis");
+    std::fs::copy(env!("CARGO_BIN_EXE_dermis"), &exe).unwrap();
+    let run = |args: &[&str], assets: Option<&std::path::Path>| {
+        let mut c = Command::new(&exe);
+        c.args(args)
+            .args(["--width", "32", "--height", "32", "--irradiance-res", "256"])
+            .arg("--validation")
+            .current_dir(&dir)
+            .env("DERMIS_NO_BUILD_ASSETS", "1")
+            .env_remove("DERMIS_ASSETS");
+        if let Some(a) = assets {
+            c.env("DERMIS_ASSETS", a);
+        }
+        c.output().unwrap()
+    };
+    let out = run(&["render", "--scene", "builtin", "--out", "b.png"], None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("b.png").is_file());
+
+    let out = run(&["render", "--out", "d.png"], None);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for looked in [
+        dir.join("assets"),
+        dir.join("bin/assets"),
+        dir.join("share/dermis/assets"),
+    ] {
+        assert!(stderr.contains(&looked.display().to_string()), "{stderr}");
+    }
+    assert!(stderr.contains("DERMIS_ASSETS"), "{stderr}");
+
+    let json = dir.join("d.json");
+    let assets = dermis::assets::dir();
+    let out = run(
+        &[
+            "render",
+            "--out",
+            "d.png",
+            "--report",
+            json.to_str().unwrap(),
+        ],
+        Some(&assets),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        report["setup"]["scene"],
+        assets.join("default.toml").display().to_string()
+    );
+}
+
+#[test]
 fn precompute_fills_the_cache_and_reports_time() {
     let cache = tmp("cache");
     let run = || {
@@ -889,4 +970,76 @@ fn view_list_prints_every_view() {
     for name in ["blur1", "blur6", "prefiltered"] {
         assert!(names.contains(&name), "{name} not in {names:?}");
     }
+}
+
+/// A validation message fails the run (exit status 4) and is counted in the
+/// report; the message is injected through the layer's own messenger
+/// (`DERMIS_TEST_VALIDATION_MESSAGE`, test-only).
+#[test]
+fn a_validation_message_fails_the_run() {
+    let json = tmp("validation-report.json");
+    let run = |message: Option<&str>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_dermis"));
+        c.args([
+            "render", "--scene", "builtin", "--width", "32", "--height", "32",
+        ])
+        .args(["--irradiance-res", "256", "--validation", "--report"])
+        .arg(&json)
+        .arg("--out")
+        .arg(tmp("validation.png"));
+        if let Some(m) = message {
+            c.env("DERMIS_TEST_VALIDATION_MESSAGE", m);
+        }
+        let out = c.output().unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (out, report["validation_messages"].clone())
+    };
+    let (out, count) = run(None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(count, 0);
+    let (out, count) = run(Some("deliberate test message"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{stderr}");
+    assert!(stderr.contains("deliberate test message"), "{stderr}");
+    assert!(
+        stderr.contains("validation layer reported 1 message"),
+        "{stderr}"
+    );
+    assert_eq!(count, 1);
+}
+
+/// The CPU reference says how far it is (plain lines: stderr is no terminal)
+/// and how well it converged.
+#[test]
+fn the_cpu_reference_reports_progress_and_convergence() {
+    let png = tmp("reference.png");
+    let out = dermis(&[
+        "render",
+        "--scene",
+        "builtin",
+        "--view",
+        "reference",
+        "--width",
+        "24",
+        "--height",
+        "20",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for line in [
+        "reference: started",
+        "reference: 50 % (10/20)",
+        "left",
+        "reference: done in",
+    ] {
+        assert!(stderr.contains(line), "{line}: {stderr}");
+    }
+    assert!(stderr.contains("converged to 0.5 %"), "{stderr}");
 }

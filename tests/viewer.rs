@@ -17,8 +17,10 @@ struct Xvfb {
 
 impl Xvfb {
     fn start() -> Xvfb {
-        // A display number no other test run is likely to hold.
-        let n = 90 + std::process::id() % 100;
+        // A display number no other test (of this run or another) is likely to hold.
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let n = 90 + (std::process::id() % 100) * 4 + k;
         let display = format!(":{n}");
         let child = Command::new("Xvfb")
             .args([&display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
@@ -96,4 +98,60 @@ fn the_viewer_shows_the_face_in_a_window_and_survives_a_resize() {
     assert!(var > 25.0, "constant: {var}");
     assert!(mean[0] > mean[2], "not skin: {mean:?}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_viewer_ends_and_writes_its_screenshot_in_tiny_windows() {
+    let x = Xvfb::start();
+    let dir = std::env::temp_dir().join(format!("dermis-viewer-tiny-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (w, h) in [(100, 100), (1, 1), (350, 200)] {
+        let shot = dir.join(format!("view-{w}x{h}.png"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_dermis"))
+            .args(["--validation", "view", "--irradiance-res", "256"])
+            .args(["--width", &w.to_string(), "--height", &h.to_string()])
+            .args(["--frames", "6", "--screenshot"])
+            .arg(&shot)
+            .env("DISPLAY", &x.display)
+            .env("RUST_LOG", "warn")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("dermis runs");
+        // Ends by itself: a hang fails here rather than holding the suite.
+        let started = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if started.elapsed() > Duration::from_secs(600) {
+                let _ = child.kill();
+                panic!("dermis view at {w}×{h} did not end in 600 s");
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        };
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+        assert!(status.success(), "{w}×{h}: {stderr}");
+        assert!(!stderr.contains("[validation]"), "{w}×{h}:\n{stderr}");
+        let img = image::open(&shot).expect("the screenshot").to_rgba8();
+        let (iw, ih) = img.dimensions();
+        assert!(
+            iw >= 1 && ih >= 1 && iw <= w.max(1) && ih <= h.max(1),
+            "{w}×{h}: {iw}×{ih}"
+        );
+        // The frame beside the panel holds more than the panel's colour
+        // wherever there is room for it.
+        if w >= 100 {
+            let right = (iw / 2..iw)
+                .flat_map(|x| (0..ih).map(move |y| (x, y)))
+                .map(|(x, y)| *img.get_pixel(x, y))
+                .collect::<std::collections::HashSet<_>>();
+            assert!(
+                right.len() > 4,
+                "{w}×{h}: the right half is {} colours",
+                right.len()
+            );
+        }
+    }
 }

@@ -48,7 +48,7 @@ pub struct ShArgs {
     #[command(flatten)]
     env: EnvArg,
     /// Rotation about +Y, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
     rotate: f32,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -63,7 +63,7 @@ pub struct LightsArgs {
     #[command(flatten)]
     env: EnvArg,
     /// Rotation of the environment about +Y, degrees (as `environment.rotation_deg`).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = finite)]
     rotate: f32,
     /// `auto` (compact sources holding ≥ 5 % of the energy) or the N strongest (0..=8).
     #[arg(
@@ -76,6 +76,15 @@ pub struct LightsArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
+}
+
+/// A finite number (clap's error, exit status 2, names the flag).
+fn finite(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("{v} is not a finite number")),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 /// `dermis info`.

@@ -15,6 +15,8 @@ pub const AFTER_HELP: &str = "\
 Environment:
   DERMIS_DEVICE=SUBSTRING   device to use (as --device)
   DERMIS_VALIDATION=1       Khronos validation + synchronization validation (as --validation)
+  DERMIS_ASSETS=DIR         the assets folder (default scene, CC0 maps), searched first
+  DERMIS_NO_BUILD_ASSETS=1  never fall back on the build's checkout for assets
   DERMIS_CACHE_DIR=DIR      occlusion transfer cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
   RUST_LOG=LEVEL            log filter (overrides -v)
   LP_NUM_THREADS=N          lavapipe's rasterizer threads (recorded in reports)
@@ -23,7 +25,8 @@ Environment:
 Exit status:
   0 success, 2 bad input (files, sizes, options), 1 anything else (device, driver,
   window system); compare and interleave with --fail-on-regression: 3 when a pass
-  regressed.";
+  regressed; with --validation: 4 when the validation layer reported any warning or
+  error (the run report counts them, validation_messages).";
 
 fn to_json(path: &Path, value: &impl serde::Serialize) -> dermis::Result<String> {
     serde_json::to_string_pretty(value)

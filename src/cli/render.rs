@@ -99,7 +99,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         frames: args.frames,
         hdr,
         view: args.view,
-        scene_path: Some(args.scene.path()),
+        scene_path: Some(args.scene.path()?),
         progress: std::io::stderr().is_terminal(),
         ruler: args.ruler,
         runs: args.runs,
@@ -121,8 +121,13 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
     dermis::render::output::write(&args.out, &output)?;
     if let Some(r) = &output.reference {
         eprintln!(
-            "reference: {} mesh pixels, {:.1} % converged to 0.5 %, mean standard error \
+            "{}reference: {} mesh pixels, {:.1} % converged to 0.5 %, mean standard error \
              {:.2} %, {:.0} directions per pixel, {:.1} s",
+            if r.converged < 1.0 {
+                "warning: not every pixel converged (sample cap reached); "
+            } else {
+                ""
+            },
             r.mesh_pixels,
             100.0 * r.converged,
             100.0 * r.mean_rel_std_err,

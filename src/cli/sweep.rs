@@ -136,7 +136,7 @@ pub fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
     }
     let opts = sw::SweepOptions {
         scene: args.scene.load(&args.overrides)?,
-        scene_label: args.scene.path().display().to_string(),
+        scene_label: args.scene.path()?.display().to_string(),
         resolutions: args.resolutions,
         kernels: args.kernels,
         chains: args.chains,

@@ -1,7 +1,7 @@
 //! Instance, device, queue, memory allocator and validation: the root every GPU
 //! object holds an `Arc` of, so that it is destroyed last.
 
-use super::validation::{messenger_info, ValidationLog};
+use super::validation::{messenger_info, ValidationLog, TEST_MESSAGE_VAR};
 use crate::error::{Error, Result, VkResultExt};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -346,7 +346,10 @@ fn create_instance(
         Some(log) => {
             let du = ash::ext::debug_utils::Instance::new(entry, &instance);
             match unsafe { du.create_debug_utils_messenger(&messenger_info(log), None) } {
-                Ok(m) => Some((du, m)),
+                Ok(m) => {
+                    submit_test_message(&du);
+                    Some((du, m))
+                }
                 Err(result) => {
                     unsafe { instance.destroy_instance(None) };
                     return Err(Error::Vk {
@@ -359,6 +362,25 @@ fn create_instance(
         None => None,
     };
     Ok((instance, messenger))
+}
+
+/// [`TEST_MESSAGE_VAR`]'s message, when set, as an error of the layer.
+fn submit_test_message(du: &ash::ext::debug_utils::Instance) {
+    let Some(text) = std::env::var(TEST_MESSAGE_VAR)
+        .ok()
+        .and_then(|t| std::ffi::CString::new(t).ok())
+    else {
+        return;
+    };
+    let data = vk::DebugUtilsMessengerCallbackDataEXT::default().message(&text);
+    // SAFETY: the instance and its messenger exist; `data` outlives the call.
+    unsafe {
+        du.submit_debug_utils_message(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+            vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION,
+            &data,
+        )
+    };
 }
 
 fn choose_device(

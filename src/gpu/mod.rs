@@ -17,6 +17,6 @@ pub use reflect::ShaderLayout;
 pub(crate) use resources::full_range;
 pub use resources::{aspect, texel_bytes, Buffer, Image, ImageDesc, Sampler};
 pub use swapchain::{Acquired, Surface, Swapchain};
-pub use validation::ValidationLog;
+pub use validation::{validation_messages, ValidationLog};
 
 pub use gpu_allocator::MemoryLocation;

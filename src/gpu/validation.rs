@@ -5,6 +5,20 @@ use std::ffi::{c_void, CStr};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Mutex;
 
+/// Validation messages of warning or error severity in this process, every
+/// context together: `main` fails the run when it is not zero (README, exit status).
+static PROCESS_MESSAGES: AtomicU32 = AtomicU32::new(0);
+
+/// How many validation messages of warning or error severity this process has had.
+pub fn validation_messages() -> u32 {
+    PROCESS_MESSAGES.load(Ordering::SeqCst)
+}
+
+/// Test-only: with validation on, `DERMIS_TEST_VALIDATION_MESSAGE=TEXT` makes the
+/// context submit TEXT as an error message through the layer's messenger, so that
+/// the tests can check a message fails the run.
+pub(crate) const TEST_MESSAGE_VAR: &str = "DERMIS_TEST_VALIDATION_MESSAGE";
+
 /// Everything the validation layer said of warning or error severity.
 #[derive(Default, Debug)]
 pub struct ValidationLog {
@@ -29,6 +43,7 @@ impl ValidationLog {
     }
 
     fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: String) {
+        PROCESS_MESSAGES.fetch_add(1, Ordering::SeqCst);
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
             self.errors.fetch_add(1, Ordering::SeqCst);
             log::error!("[validation] {text}");

@@ -1,5 +1,5 @@
 //! The soft lights' visibility in texture space, once per render (the mesh and
-//! the lights do not move within one; render::frame::Kept): for each light
+//! the lights do not move within one; kept by key, graph::Kept): for each light
 //! with an angular size (the environment's extracted sources), percentage-closer
 //! soft shadows from its tile of the shadow atlas at every texel of the mesh's
 //! UV layout (shaders-glsl/light_visibility.frag). The shading passes (irradiance,

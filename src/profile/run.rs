@@ -201,6 +201,11 @@ pub struct RunReport {
     /// first run.
     pub warmup_only: Vec<PassTime>,
     pub per_frame: Vec<FrameReport>,
+    /// With validation on: the validation layer's messages (warnings and errors)
+    /// up to the report, which make the run fail (exit status 4); absent with
+    /// validation off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation_messages: Option<u32>,
 }
 
 impl RunReport {
@@ -283,6 +288,7 @@ impl RunReport {
             median: FrameReport::median(&measured_owned),
             warmup_only,
             per_frame,
+            validation_messages: device.validation.then(crate::gpu::validation_messages),
         }
     }
 

@@ -4,7 +4,7 @@
 
 mod frame;
 pub mod output;
-mod progress;
+pub mod progress;
 pub mod ruler;
 pub mod session;
 pub mod sheet;
@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Context, DeviceInfo};
 use crate::graph::upload::Readback;
 use crate::graph::{Executor, Graph, Kept};
-use crate::light::reference::{render_view, ReferenceImage, Settings as ReferenceSettings};
+use crate::light::reference::{render_view_with, ReferenceImage, Settings as ReferenceSettings};
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
@@ -295,7 +295,7 @@ fn single(opts: &RenderOptions) -> RenderOptions {
     }
 }
 
-/// The debug sheet: every view of [`SHEET_VIEWS`] rendered (one frame each, on
+/// The debug sheet: every view of [`sheet_views`] rendered (one frame each, on
 /// one upload of the scene) and labelled with its name.
 pub fn debug_sheet(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<Sheet> {
     let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
@@ -456,7 +456,9 @@ fn run(
 /// encoded as the GPU's image would be; its report has no passes.
 fn reference(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     let (w, h) = (scene.file.render.width, scene.file.render.height);
-    let mut image = render_view(scene, w, h, &ReferenceSettings::default())?;
+    let task = progress::Task::new("reference", h.into());
+    let mut image = render_view_with(scene, w, h, &ReferenceSettings::default(), &|| task.add(1))?;
+    drop(task);
     let post = PostSettings::resolve(&scene.file.render);
     let metered = (post.exposure == Exposure::Metered).then(|| meter::exposure(&image.rgba));
     let ev = match post.exposure {

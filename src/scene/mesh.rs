@@ -42,6 +42,19 @@ impl Mesh {
         }
     }
 
+    /// Total area of the triangles in UV space (1: the whole map, once), out of
+    /// range indices skipped.
+    pub fn uv_area(&self) -> f64 {
+        self.indices
+            .chunks_exact(3)
+            .filter_map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.uvs.get(i as usize).copied());
+                let (a, b, c) = (a?, b?, c?);
+                Some(0.5 * f64::from((b - a).perp_dot(c - a)).abs())
+            })
+            .sum()
+    }
+
     /// Axis-aligned bounds (min, max) in mm; `None` for an empty mesh.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.positions.first()?;

@@ -9,6 +9,7 @@ pub mod gltf;
 pub mod head;
 pub mod mesh;
 pub mod overrides;
+pub mod range;
 pub mod texture;
 
 #[cfg(test)]
@@ -180,7 +181,8 @@ impl Scene {
                 shadow: l.shadow,
                 angular_radius: 0.5 * l.angular_diameter_deg.to_radians(),
             })
-            .collect();
+            .collect::<Vec<_>>();
+        range::check(&file, &env, &lights, &mesh).map_err(crate::Error::Input)?;
         Ok(Scene {
             mesh,
             albedo,

@@ -15,7 +15,8 @@ use crate::error::Result;
 #[derive(Clone, Debug, Default, clap::Args)]
 pub struct SceneArg {
     /// Scene file (docs/scene-format.md), or `builtin` for the built-in
-    /// procedural head under the sky; default: assets/default.toml.
+    /// procedural head under the sky; default: assets/default.toml, looked for
+    /// in $DERMIS_ASSETS, ./assets, then beside the executable (README.md, "Assets").
     #[arg(long)]
     pub scene: Option<PathBuf>,
 }
@@ -32,8 +33,11 @@ impl SceneArg {
     }
 
     /// The scene file it names (the default scene's when none).
-    pub fn path(&self) -> PathBuf {
-        self.scene.clone().unwrap_or_else(file::default_scene_path)
+    pub fn path(&self) -> Result<PathBuf> {
+        match &self.scene {
+            Some(p) => Ok(p.clone()),
+            None => Ok(file::default_scene_path()?),
+        }
     }
 }
 

@@ -12,11 +12,12 @@
 use super::metric::{relative, RelativeError};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::light::reference::{render_view, Settings};
+use crate::light::reference::{render_view_with, Settings};
 use crate::post::meter;
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
 use crate::render::output::{write_exr, write_rgba8_png};
+use crate::render::progress::Task;
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::env::EnvSource;
 use crate::scene::file::{LightsMode, SceneFile};
@@ -81,7 +82,11 @@ pub fn run(
         file.render.width = opts.width;
         file.render.height = opts.height;
         let mut scene = Scene::load(file)?;
-        let reference = render_view(&scene, opts.width, opts.height, &opts.settings)?;
+        let task = Task::new(&format!("reference of {env}"), opts.height.into());
+        let reference = render_view_with(&scene, opts.width, opts.height, &opts.settings, &|| {
+            task.add(1)
+        })?;
+        drop(task);
         let mut direct = |lights: LightsMode| -> Result<(Vec<f32>, usize)> {
             scene.file.environment.lights = lights;
             let out = render_scene(

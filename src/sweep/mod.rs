@@ -20,6 +20,7 @@ use crate::gpu::Context;
 use crate::profile::csv::field;
 use crate::profile::fingerprint::{run_id, timestamp};
 use crate::profile::{Fingerprint, PassStats, RunReport, GIT_COMMIT, RULER_COPY, VERSION};
+use crate::render::progress::Task;
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::file::{Chain, Kernel, SceneFile};
 use crate::scene::Scene;
@@ -210,8 +211,14 @@ impl<'a> Session<'a> {
         file.render.skybox = false;
         let mut scene = Scene::load(file)?;
         let reference = points::reference(opts);
+        let task = Task::new(
+            &format!("sweep: reference {} (2 renders)", reference.id()),
+            2,
+        );
         let (ref_final, report) = render(ctx, &mut scene, reference, View::FINAL, 1)?;
+        task.add(1);
         let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::named("diffuse"), 1)?;
+        drop(task);
         Ok(Self {
             ctx,
             opts,
@@ -330,17 +337,26 @@ pub fn run(
         }
         None => None,
     };
-    for v in mine {
-        if done.iter().any(|p| p.id == v.id()) {
-            continue;
-        }
+    let todo: Vec<Variant> = mine
+        .into_iter()
+        .filter(|v| !done.iter().any(|p| p.id == v.id()))
+        .collect();
+    // The time left weighed by texels: a 4096² point costs 256 × a 256² one.
+    let texels = |v: &Variant| u64::from(v.resolution).pow(2);
+    let task = Task::new(
+        &format!("sweep: {} points", todo.len()),
+        todo.iter().map(texels).sum(),
+    );
+    for v in todo {
         let point = session.point(v)?;
         if let Some(w) = &mut writer {
             w.append(&point)?;
         }
-        progress(&point);
+        task.suspend(|| progress(&point));
+        task.add(texels(&v));
         done.push(point);
     }
+    drop(task);
     done.sort_by_key(|p| ids.iter().position(|id| *id == p.id));
     sweep.points = done;
     Ok(sweep)

@@ -157,6 +157,8 @@ impl App {
                         self.timings.add_frame(r);
                     }
                 }
+                // A headless run waits for a render: one that failed ends it.
+                Err(e) if self.opts.frames.is_some() => return Err(e),
                 Err(e) => self.last = format!("error: {e}"),
             }
         }
@@ -183,8 +185,13 @@ impl App {
             area.width().max(0.0),
             area.height().max(0.0),
         ];
-        let size = (rect[2].round() as u32, rect[3].round() as u32);
-        let minimised = size.0 == 0 || size.1 == 0;
+        // At least a pixel: the panel takes at most half the window (ui::show).
+        let size = (
+            rect[2].round().max(1.0) as u32,
+            rect[3].round().max(1.0) as u32,
+        );
+        let window = open.window.inner_size();
+        let minimised = window.width == 0 || window.height == 0;
         if !minimised && self.sent.as_ref() != Some(&(self.controls.clone(), size)) {
             open.worker.send(Job {
                 file: self.controls.file.clone(),
@@ -203,10 +210,9 @@ impl App {
         if let Some(n) = headless {
             if !self.resized && self.frames >= n / 2 {
                 self.resized = true;
-                let window = open.window.inner_size();
                 let _ = open.window.request_inner_size(PhysicalSize::new(
-                    window.width * 3 / 4,
-                    window.height * 3 / 4,
+                    (window.width * 3 / 4).max(1),
+                    (window.height * 3 / 4).max(1),
                 ));
             }
         }

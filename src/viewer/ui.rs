@@ -38,8 +38,7 @@ pub struct Controls {
 pub fn environments(scene_env: &EnvSource) -> Vec<(String, EnvSource)> {
     let mut out = vec![("scene's".to_string(), scene_env.clone())];
     for name in crate::assets::ENV_MAPS {
-        let path = crate::assets::path(&format!("env/{name}"));
-        if path.is_file() {
+        if let Ok(path) = crate::assets::find(&format!("env/{name}")) {
             out.push((name.to_string(), EnvSource::File(path)));
         }
     }
@@ -137,8 +136,11 @@ pub fn show(
     timings: &Timings,
 ) -> (bool, egui::Rect) {
     let mut screenshot = false;
+    // At most half the window: the frame beside it never shrinks to nothing.
+    let most = 0.5 * ui.max_rect().width();
     egui::Panel::left("controls")
         .default_size(270.0)
+        .size_range(egui::Rangef::new(0.0, most.max(0.0)))
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.heading("dermis");

@@ -74,6 +74,17 @@ pub fn render_view(
     height: u32,
     settings: &Settings,
 ) -> Result<ReferenceImage> {
+    render_view_with(scene, width, height, settings, &|| {})
+}
+
+/// [`render_view`], calling `row_done` as each row completes (from any thread).
+pub fn render_view_with(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    settings: &Settings,
+    row_done: &(dyn Fn() + Sync),
+) -> Result<ReferenceImage> {
     let started = Instant::now();
     if width == 0 || height == 0 {
         return Err(Error::Input(format!(
@@ -132,6 +143,7 @@ pub fn render_view(
                 };
                 row.rgba.extend(colour.to_array());
             }
+            row_done();
             row
         })
         .collect();

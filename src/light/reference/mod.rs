@@ -23,6 +23,6 @@ mod test_meshes;
 mod texture;
 
 pub use env_sampler::{luminance, EnvSampler};
-pub use image::{render_view, ReferenceImage};
+pub use image::{render_view, render_view_with, ReferenceImage};
 pub use integrate::{Estimate, Settings};
 pub use per_vertex::per_vertex;

@@ -456,6 +456,18 @@ mod tests {
     }
 
     #[test]
+    fn an_rgbe_file_of_maximum_exponents_is_sanitized() {
+        // 4 × 2 flat RGBE pixels (too narrow for run-length encoding), all 255.
+        let p = temp_dir("max-exponent").join("max.hdr");
+        let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+        bytes.extend([255u8; 4 * 8]);
+        std::fs::write(&p, bytes).unwrap();
+        let (env, r) = load(&p).unwrap();
+        assert_eq!(r.inf, 3 * 8, "{r:?}");
+        assert!(env.texels.iter().all(|t| *t == Vec3::splat(HALF_MAX)));
+    }
+
+    #[test]
     fn load_real_maps() {
         let dir = assets();
         for name in crate::assets::ENV_MAPS {

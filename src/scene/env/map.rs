@@ -266,8 +266,14 @@ impl EnvMap {
     }
 }
 
+/// Radiance beyond any physical source (the sun's disc is ~1e9 cd/m²), where a
+/// map's sums (mips, SH, the lights' power) would overflow f32: a decoder's
+/// value above it (an RGBE file of maximum exponents, ~1.7e38) counts as +Inf.
+pub const MAX_RADIANCE: f32 = 1e20;
+
 /// Replace bad channel values in place: NaN → 0, negative (incl. −Inf) → 0,
-/// +Inf → [`HALF_MAX`]. Returns per-kind counts (per channel value).
+/// +Inf and values above [`MAX_RADIANCE`] → [`HALF_MAX`]. Returns per-kind
+/// counts (per channel value).
 pub fn sanitize(texels: &mut [Vec3]) -> SanitizeReport {
     let mut r = SanitizeReport::default();
     for t in texels.iter_mut() {
@@ -275,7 +281,7 @@ pub fn sanitize(texels: &mut [Vec3]) -> SanitizeReport {
             if c.is_nan() {
                 r.nan += 1;
                 *c = 0.0;
-            } else if c.is_infinite() {
+            } else if c.is_infinite() || *c > MAX_RADIANCE {
                 r.inf += 1;
                 *c = if *c > 0.0 { HALF_MAX } else { 0.0 };
             } else if *c < 0.0 {
@@ -360,16 +366,18 @@ mod tests {
         env.texels[0] = Vec3::new(f32::NAN, 1.0, f32::NAN);
         env.texels[1] = Vec3::new(f32::INFINITY, -2.0, f32::NEG_INFINITY);
         env.texels[2] = Vec3::new(-0.0, -1e-9, 3.0);
+        env.texels[3] = Vec3::new(1e9, f32::MAX, 0.5);
         let r = env.sanitize();
         assert_eq!(
             r,
             SanitizeReport {
                 nan: 2,
-                inf: 2,
+                inf: 3,
                 negative: 2
             }
         );
         assert_eq!(env.texels[0], Vec3::new(0.0, 1.0, 0.0));
+        assert_eq!(env.texels[3], Vec3::new(1e9, HALF_MAX, 0.5));
         assert_eq!(env.texels[1], Vec3::new(HALF_MAX, 0.0, 0.0));
         assert_eq!(env.texels[2].y, 0.0);
         assert!(env

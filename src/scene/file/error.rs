@@ -26,6 +26,9 @@ pub enum SceneError {
     /// A mesh file that cannot be used.
     #[error("{}: {message}", path.display())]
     Mesh { path: PathBuf, message: String },
+    /// The repository's assets (the default scene) are nowhere dermis looked.
+    #[error("{0}")]
+    Assets(String),
     /// A texture file that cannot be used.
     #[error("{}: {message}", path.display())]
     Texture { path: PathBuf, message: String },

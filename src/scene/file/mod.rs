@@ -106,9 +106,9 @@ impl std::str::FromStr for UvOrigin {
 pub const BUILTIN: &str = "builtin";
 
 /// The scene `dermis render` draws when none is named: `assets/default.toml`, the
-/// scan under a CC0 map, framed as a portrait.
-pub fn default_scene_path() -> PathBuf {
-    crate::assets::dir().join("default.toml")
+/// scan under a CC0 map, framed as a portrait, found by [`crate::assets::find`].
+pub fn default_scene_path() -> Result<PathBuf, SceneError> {
+    crate::assets::find("default.toml").map_err(SceneError::Assets)
 }
 
 /// The scene a command line names: `None` the default scene, [`BUILTIN`] the
@@ -117,7 +117,7 @@ pub fn scene_by_name(name: Option<&Path>) -> Result<SceneFile, SceneError> {
     match name {
         Some(p) if p == Path::new(BUILTIN) => Ok(SceneFile::default()),
         Some(p) => load_scene(p),
-        None => load_scene(&default_scene_path()),
+        None => load_scene(&default_scene_path()?),
     }
 }
 

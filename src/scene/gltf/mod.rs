@@ -106,8 +106,21 @@ pub fn load_mesh_from_slice(
     }
     mesh.validate()
         .map_err(|m| SceneError::mesh(path, format!("invalid mesh: {m}")))?;
+    let uv_area = mesh.uv_area();
+    if uv_area < MIN_UV_AREA {
+        return Err(SceneError::mesh(
+            path,
+            format!(
+                "TEXCOORD_0 covers no texels (total UV area {uv_area:.3e}, less than one texel \
+                 of a 1024² map): texture-space diffusion needs the mesh unwrapped over [0, 1]²"
+            ),
+        ));
+    }
     Ok(mesh)
 }
+
+/// Least total UV area a mesh may have: one texel of a 1024² map.
+const MIN_UV_AREA: f64 = 1.0 / (1024.0 * 1024.0);
 
 /// One primitive in world millimetres, ready to merge.
 pub(super) struct Part {
@@ -909,6 +922,20 @@ mod tests {
                     ..square()
                 },
                 "TEXCOORD_0 has 3",
+            ),
+            (
+                Doc {
+                    uvs: Some(vec![[0.5, 0.5]; 4]),
+                    ..square()
+                },
+                "TEXCOORD_0 covers no texels",
+            ),
+            (
+                Doc {
+                    uvs: Some(vec![[0., 0.], [1e-4, 0.], [1e-4, 1e-4], [0., 1e-4]]),
+                    ..square()
+                },
+                "TEXCOORD_0 covers no texels",
             ),
             (
                 Doc {
