@@ -208,7 +208,8 @@ fn letterbox(frame: Option<(u32, u32)>, [x, y, aw, ah]: [f32; 4]) -> [f32; 4] {
     [x + (aw - w) / 2.0, y + (ah - h) / 2.0, w, h]
 }
 
-/// Writes a swapchain image read back as `format` (BGRA or RGBA) as a PNG.
+/// Writes a swapchain image read back as `format` (BGRA or RGBA) as a PNG, whole
+/// or not at all.
 fn save_png(path: &Path, bytes: &[u8], (w, h): (u32, u32), format: vk::Format) -> Result<()> {
     let mut rgba = bytes.to_vec();
     if format == vk::Format::B8G8R8A8_UNORM {
@@ -216,8 +217,8 @@ fn save_png(path: &Path, bytes: &[u8], (w, h): (u32, u32), format: vk::Format) -
             p.swap(0, 2);
         }
     }
-    image::save_buffer(path, &rgba, w, h, image::ExtendedColorType::Rgba8)
-        .map_err(|e| Error::Input(format!("{}: cannot write PNG: {e}", path.display())))
+    // Encoded in memory and renamed into place (atomic).
+    crate::render::output::write_rgba8_png(path, w, h, &rgba)
 }
 
 #[cfg(test)]
