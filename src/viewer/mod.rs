@@ -50,7 +50,8 @@ pub fn run(opts: ViewerOptions) -> Result<()> {
     let orbit = Orbit::of(&crate::scene::camera_for(&opts.scene, bounds));
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
         Error::Window(format!(
-            "no display to open a window on ({e}); set DISPLAY, or run under Xvfb"
+            "no display to open a window on ({}); set DISPLAY, or run under Xvfb",
+            without_location(&e.to_string())
         ))
     })?;
     let mut app = app::App::new(opts, orbit);
@@ -60,5 +61,27 @@ pub fn run(opts: ViewerOptions) -> Result<()> {
     match app.error.take() {
         Some(e) => Err(e),
         None => Ok(()),
+    }
+}
+
+/// winit's message without the source location it prefixes ("os error at
+/// FILE:LINE: message"): a path inside the cargo registry means nothing to a user.
+fn without_location(message: &str) -> &str {
+    match message.strip_prefix("os error at ") {
+        Some(rest) => rest.split_once(": ").map_or(rest, |(_, m)| m),
+        None => message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn winit_messages_lose_their_source_location() {
+        let m = "os error at /root/.cargo/registry/src/x/winit-0.30.13/src/platform_impl/linux/mod.rs:765: neither WAYLAND_DISPLAY nor DISPLAY is set.";
+        assert_eq!(
+            super::without_location(m),
+            "neither WAYLAND_DISPLAY nor DISPLAY is set."
+        );
+        assert_eq!(super::without_location("plain"), "plain");
     }
 }
