@@ -34,8 +34,8 @@ impl Graph {
     ) -> (ImageHandle, bool) {
         let valid = self.kept.holds(name, key);
         let handle = self.import_image(name, image, valid.then_some(access), Some(access));
-        self.resources[handle.id].kept_key = Some(key);
-        (handle, !valid)
+        let compute = self.keep(handle.id, key, valid);
+        (handle, compute)
     }
 
     /// [`Graph::import_kept_image`] for a buffer.
@@ -48,8 +48,14 @@ impl Graph {
     ) -> (BufferHandle, bool) {
         let valid = self.kept.holds(name, key);
         let handle = self.import_buffer(name, buffer, valid.then_some(access), Some(access));
-        self.resources[handle.id].kept_key = Some(key);
-        (handle, !valid)
+        let compute = self.keep(handle.id, key, valid);
+        (handle, compute)
+    }
+
+    /// Marks resource `id` kept for `key`; whether it is to be computed.
+    fn keep(&mut self, id: usize, key: u64, valid: bool) -> bool {
+        self.resources[id].kept_key = Some(key);
+        !valid
     }
 
     /// Drops the passes no output depends on, and returns what the owner keeps

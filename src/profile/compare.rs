@@ -10,7 +10,7 @@
 
 use super::bootstrap::relative_change_ci;
 use super::fingerprint::Fingerprint;
-use super::run::{RunReport, RULER_COPY, SCHEMA_VERSION};
+use super::run::{is_ruler, RunReport, RULER_COPY, SCHEMA_VERSION};
 use super::significance::{holm, mann_whitney_p, smallest_p};
 use super::stats::{median, Stats};
 use crate::error::{Error, Result};
@@ -472,7 +472,7 @@ fn in_ruler_units(
     let common: Vec<&String> = base
         .pass_order
         .iter()
-        .filter(|n| new.pass_order.contains(n) && !n.starts_with("ruler_"))
+        .filter(|n| new.pass_order.contains(n) && !is_ruler(n))
         .collect();
     Ok(match opts.unit {
         Unit::Ms => false,
@@ -522,8 +522,8 @@ fn pass_change(
     ruler: bool,
     by_run: bool,
 ) -> PassChange {
-    let is_ruler = name.starts_with("ruler_");
-    let in_ruler = ruler && !is_ruler;
+    let ruler_pass = is_ruler(name);
+    let in_ruler = ruler && !ruler_pass;
     let (b, n) = (
         samples(base, name, in_ruler, by_run),
         samples(new, name, in_ruler, by_run),
@@ -560,7 +560,7 @@ fn pass_change(
         p: mann_whitney_p(&b, &n),
         p_holm: 1.0,
         verdict: Verdict::Inconclusive,
-        ruler: is_ruler,
+        ruler: ruler_pass,
         more_samples: None,
     }
 }
@@ -592,7 +592,7 @@ fn samples(m: &Measurement, name: &str, in_ruler: bool, by_run: bool) -> Vec<f64
             let v: f64 = f
                 .passes
                 .iter()
-                .filter(|(n, _)| !n.starts_with("ruler_"))
+                .filter(|(n, _)| !is_ruler(n))
                 .map(|(_, v)| v)
                 .sum();
             (v > 0.0).then_some(v)

@@ -13,8 +13,8 @@ pub mod trace;
 
 pub use fingerprint::Fingerprint;
 pub use run::{
-    CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY, RULER_COPY,
-    SCHEMA_VERSION, VERSION,
+    is_ruler, CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY,
+    RULER_COPY, RULER_READ, SCHEMA_VERSION, VERSION,
 };
 pub use stats::Stats;
 

@@ -102,6 +102,14 @@ pub struct MemoryUse {
 /// The pass whose cost per texel every other pass is compared with (render's
 /// `--ruler`: a plain RGBA16F copy at the irradiance resolution).
 pub const RULER_COPY: &str = "ruler_copy";
+/// The read ruler's pass name (render::ruler).
+pub const RULER_READ: &str = "ruler_read";
+
+/// Whether a pass is a ruler: by name, so that reports written before passes
+/// carried tags are read the same way.
+pub fn is_ruler(name: &str) -> bool {
+    name == RULER_COPY || name == RULER_READ
+}
 
 /// One pass (or the frame span) over the measured frames.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]

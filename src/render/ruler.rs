@@ -7,7 +7,7 @@
 use crate::error::Result;
 use crate::gpu::{ImageDesc, Pipelines, Sampler};
 use crate::graph::{Graph, ImageHandle};
-use crate::profile::RULER_COPY;
+use crate::profile::{RULER_COPY, RULER_READ};
 use std::sync::Arc;
 
 /// The tag of the ruler passes.
@@ -29,7 +29,7 @@ pub fn passes(
         .store(&mut copy)
         .dispatch([desc.width, desc.height, 1]);
     let mut sink = g.create_image("ruler sink", ImageDesc::new(1, 1, desc.format));
-    g.simple_pass("ruler_read", &pipelines.compute("ruler_read.comp", &[])?)
+    g.simple_pass(RULER_READ, &pipelines.compute("ruler_read.comp", &[])?)
         .tag(TAG)
         .sample(src, sampler)
         .store(&mut sink)

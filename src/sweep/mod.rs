@@ -238,10 +238,9 @@ impl<'a> Session<'a> {
         let (image, report) = render(ctx, &mut self.scene, variant, View::FINAL, frames)?;
         let (diffuse, _) = render(ctx, &mut self.scene, variant, View::named("diffuse"), 1)?;
         let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
-        // By the tags the passes declare (render::ruler::TAG, skin::TAG).
-        let tagged = |p: &PassStats, tag: &str| p.tags.iter().any(|t| t == tag);
-        let is_ruler = |p: &PassStats| tagged(p, crate::render::ruler::TAG);
-        let is_chain = |p: &PassStats| tagged(p, crate::skin::TAG);
+        // The chain by the tag its passes declare (skin::TAG).
+        let is_ruler = |p: &PassStats| crate::profile::is_ruler(&p.name);
+        let is_chain = |p: &PassStats| p.tags.iter().any(|t| t == crate::skin::TAG);
         Ok(Point {
             id: variant.id(),
             variant,

@@ -202,7 +202,7 @@ where
     let mut groups: Vec<String> = Vec::new();
     for p in sweep.points.iter().flat_map(|p| &p.passes) {
         let g = group(&p.name);
-        if !p.name.starts_with("ruler_") && !groups.contains(&g) {
+        if !crate::profile::is_ruler(&p.name) && !groups.contains(&g) {
             groups.push(g);
         }
     }
@@ -260,7 +260,7 @@ where
                 let ms = |filter: &dyn Fn(&str) -> bool| {
                     p.passes
                         .iter()
-                        .filter(|s| !s.name.starts_with("ruler_") && filter(&s.name))
+                        .filter(|s| !crate::profile::is_ruler(&s.name) && filter(&s.name))
                         .map(|s| s.time.map_or(0.0, |t| t.median_ns) / 1e6)
                         .filter(|ms| ms.is_finite())
                         .sum::<f64>()
