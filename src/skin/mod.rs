@@ -6,6 +6,7 @@ pub mod blur;
 pub mod chain;
 pub mod irradiance;
 pub mod profile;
+pub mod reference;
 pub mod shade;
 pub mod specular;
 pub mod stretch;
