@@ -101,3 +101,59 @@ fn extracted_lights_beat_sh9_alone_under_a_sunny_map() {
     assert!(r.sh9_lights.mean <= 0.08, "{:?}", r.sh9_lights);
     assert!(3.0 * r.sh9_lights.mean <= r.sh9.mean, "{r:?}");
 }
+
+/// The texture-space chain against the exact diffusion over the scan's surface
+/// (skin::reference, checked against closed forms in its unit tests): every
+/// face region of the landmark masks is populated, and the chain (full and
+/// adaptive) is close to the reference over the face, the seams and the mesh.
+/// The docs' figures (docs/skin.md, "Exact diffusion") come from 1024².
+#[test]
+fn texture_space_diffusion_against_the_exact_reference() {
+    use dermis::scene::file::Chain;
+    use dermis::skin::specular::REGION_NAMES;
+    use dermis::sweep::diffusion::{run, table, DiffusionOptions};
+    let mut scene = scene_by_name(None).unwrap();
+    scene.render.irradiance_resolution = 256;
+    let opts = DiffusionOptions {
+        scene,
+        chains: vec![Chain::Full, Chain::Adaptive],
+        stride: 4,
+        out_dir: None,
+    };
+    let rows = common::with_gpu(|ctx| run(ctx, &opts, |_| {}).unwrap());
+    println!("{}", table(&rows));
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        let region = |name: &str| {
+            r.regions
+                .iter()
+                .find(|g| g.region.starts_with(name))
+                .unwrap_or_else(|| panic!("{}: no texels in {name}", r.chain))
+        };
+        for name in REGION_NAMES
+            .iter()
+            .chain(&["face", "UV seams", "scattering", "all"])
+        {
+            assert!(region(name).error.pixels >= 10, "{}: {name}", r.chain);
+        }
+        assert!(region("all").error.pixels > 2000);
+        assert!(
+            region("all").error.mean < 0.02,
+            "{}: {:?}",
+            r.chain,
+            region("all")
+        );
+        assert!(
+            region("face").error.mean < 0.05,
+            "{}: {:?}",
+            r.chain,
+            region("face")
+        );
+        assert!(
+            region("UV seams").error.mean < 0.05,
+            "{}: {:?}",
+            r.chain,
+            region("UV seams")
+        );
+    }
+}

@@ -24,6 +24,15 @@ pub struct ReferenceArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// Compare the skin's texture-space diffusion, full and adaptive chain,
+    /// with the exact diffusion over the surface in 3-D (per face region, UV
+    /// seams, shadow edges) instead of the lighting.
+    #[arg(long)]
+    diffusion: bool,
+    /// With --diffusion: compare every STRIDE-th texel in u and v (default:
+    /// the irradiance resolution / 256).
+    #[arg(long, requires = "diffusion")]
+    stride: Option<u32>,
 }
 
 /// The scene and its overrides, but `--env` repeats (one comparison each) and
@@ -80,6 +89,16 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
     } else {
         envs
     };
+    if args.diffusion {
+        return diffusion(
+            file,
+            environments,
+            args.stride,
+            args.out_dir,
+            args.json,
+            context,
+        );
+    }
     let target_error = args.target_error;
     if !(target_error > 0.0 && target_error < 1.0) {
         return Err(dermis::Error::Input(format!(
@@ -149,4 +168,47 @@ mod tests {
             (Some(64), Some(1.0))
         );
     }
+}
+
+/// `dermis reference --diffusion`.
+fn diffusion(
+    file: dermis::scene::file::SceneFile,
+    environments: Vec<EnvSource>,
+    stride: Option<u32>,
+    out_dir: Option<PathBuf>,
+    json: bool,
+    context: &ContextOptions,
+) -> dermis::Result<()> {
+    use dermis::scene::file::Chain;
+    use dermis::sweep::diffusion as d;
+    let stride = stride.unwrap_or((file.render.irradiance_resolution / 256).max(1));
+    if stride == 0 {
+        return Err(dermis::Error::Input("--stride 0: give 1 or more".into()));
+    }
+    let ctx = Context::new(context)?;
+    let mut rows = Vec::new();
+    for (k, env) in environments.into_iter().enumerate() {
+        let mut scene = file.clone();
+        scene.environment.source = env;
+        let opts = d::DiffusionOptions {
+            scene,
+            chains: vec![Chain::Full, Chain::Adaptive],
+            stride,
+            out_dir: out_dir.as_ref().map(|dir| dir.join(k.to_string())),
+        };
+        rows.extend(d::run(&ctx, &opts, |r| {
+            if !json {
+                eprintln!(
+                    "{} chain: reference in {:.0} s",
+                    r.chain, r.reference_seconds
+                );
+            }
+        })?);
+    }
+    if json {
+        println!("{}", to_json(Path::new("stdout"), &rows)?);
+    } else {
+        print!("{}", d::table(&rows));
+    }
+    Ok(())
 }

@@ -285,6 +285,35 @@ fn flipped(scene: &Scene, view: &View) -> bool {
     view.uv_space() && scene.file.textures.uv_origin == UvOrigin::BottomLeft
 }
 
+/// Images of the frame graph by name (RGBA16F, UV-space), one frame each on one
+/// upload of the scene, as stored: rows in the order of v, not flipped for
+/// display. Each is (width, height, linear RGBA).
+pub fn stored_images(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    names: &[String],
+) -> Result<Vec<(u32, u32, Vec<f32>)>> {
+    let frame = Frame::new(ctx, scene, &scene.albedo, settings(ctx, scene)?, false)?;
+    names
+        .iter()
+        .map(|name| {
+            let view = View::Image(name.clone());
+            let out = run(
+                ctx,
+                scene,
+                &frame,
+                &view,
+                &single(&RenderOptions::default()),
+            )?;
+            let mut values = out.hdr.unwrap_or_default();
+            if flipped(scene, &view) {
+                flip_rows(&mut values, out.width as usize * 4);
+            }
+            Ok((out.width, out.height, values))
+        })
+        .collect()
+}
+
 /// One frame of each view, without progress bar or HDR image.
 fn single(opts: &RenderOptions) -> RenderOptions {
     RenderOptions {

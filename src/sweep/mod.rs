@@ -4,6 +4,7 @@
 //! kernel, full chain) over the face. Writes a CSV, a JSON and plots.
 
 pub mod compare;
+pub mod diffusion;
 pub mod hash;
 pub mod interleave;
 pub mod lighting;

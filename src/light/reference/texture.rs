@@ -34,7 +34,7 @@ pub fn env(map: &EnvMap, uv: Vec2) -> Vec3 {
 }
 
 /// The four texels around `uv` (clamped to the edge), linearly weighted.
-fn bilinear(width: u32, height: u32, uv: Vec2, fetch: impl Fn(u32, u32) -> Vec4) -> Vec4 {
+pub fn bilinear(width: u32, height: u32, uv: Vec2, fetch: impl Fn(u32, u32) -> Vec4) -> Vec4 {
     let p = uv * Vec2::new(width as f32, height as f32) - 0.5;
     let p = if p.is_finite() { p } else { Vec2::ZERO };
     let base = p.floor();

@@ -127,6 +127,11 @@ impl<'a> Diffusion<'a> {
         }
     }
 
+    /// Each Gaussian's reach (EXTENT_SIGMA σ), mm.
+    pub fn reach(&self) -> &[f32] {
+        &self.reach
+    }
+
     /// The widest Gaussian's reach, mm.
     pub fn extent(&self) -> f32 {
         *self.reach.last().expect("checked non-empty")

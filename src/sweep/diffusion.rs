@@ -1,0 +1,441 @@
+//! `dermis reference --diffusion`: the texture-space chain against the exact
+//! diffusion over the surface (skin::reference). The scene's irradiance and
+//! blur levels are rendered and read back as stored; at the covered texels of
+//! the irradiance's resolution (every `stride`-th), the reference convolves the
+//! same irradiance with the same profile in 3-D, and both give the diffused
+//! irradiance the final pass shades, `mix(E, Σ wₖ·blurₖ, blur_amount)`. The
+//! relative error of luminance (sweep::metric::relative) is reported per face
+//! region of the region map, near UV seams, where scattering changes the light
+//! by more than 20 %, and over the face. docs/skin.md, "Exact diffusion".
+
+use super::metric::{relative, RelativeError};
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use crate::light::reference::bilinear;
+use crate::render::output::{write_exr, write_rgba8_png};
+use crate::render::progress::Task;
+use crate::render::stored_images;
+use crate::scene::file::{Chain, SceneFile};
+use crate::scene::Scene;
+use crate::skin::reference::{texels, Diffusion, MeshEdges, Texel};
+use crate::skin::specular::REGION_NAMES;
+use crate::skin::SkinSettings;
+use glam::{Vec2, Vec3, Vec4};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Texels within this distance (mm) of a UV seam are the seam region (issue 22).
+pub const SEAM_MM: f32 = 2.0;
+/// Where |D_ref − E| > this share of D_ref, scattering changes the light
+/// visibly: shadow edges, the terminator (issue 22's "more than 20 %").
+pub const SCATTERING_CHANGE: f32 = 0.2;
+/// Below this coverage a level's texel has no value of its own.
+const MIN_COVERAGE: f32 = 1e-3;
+
+#[derive(Clone, Debug)]
+pub struct DiffusionOptions {
+    pub scene: SceneFile,
+    pub chains: Vec<Chain>,
+    /// Every `stride`-th texel in u and v is compared.
+    pub stride: u32,
+    /// Where to write the reference's and each chain's diffused irradiance and
+    /// error (EXR, UV space at resolution / stride).
+    pub out_dir: Option<PathBuf>,
+}
+
+/// One chain's errors against the reference.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiffusionRow {
+    pub environment: String,
+    pub chain: String,
+    pub resolution: u32,
+    pub stride: u32,
+    /// Per region: name, error, and the bias per channel (R, G, B).
+    pub regions: Vec<RegionRow>,
+    pub reference_seconds: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RegionRow {
+    pub region: String,
+    pub error: RelativeError,
+    /// Σ(chain − reference)/Σ reference per channel: the colour's bias.
+    pub bias_rgb: [f64; 3],
+}
+
+/// The reference at every texel, and what the comparison needs of the mesh.
+struct Reference {
+    texels: Vec<Texel>,
+    irradiance: Vec<Vec3>,
+    diffused: Vec<Vec3>,
+    masks: Vec<(String, Vec<bool>)>,
+    /// Each texel's face region.
+    region: Vec<usize>,
+    seconds: f64,
+}
+
+/// Runs the comparison for every chain of `opts`.
+pub fn run(
+    ctx: &Arc<Context>,
+    opts: &DiffusionOptions,
+    mut progress: impl FnMut(&DiffusionRow),
+) -> Result<Vec<DiffusionRow>> {
+    if opts.chains.is_empty() || opts.stride == 0 {
+        return Err(Error::Input(
+            "reference --diffusion: give at least one chain and a stride ≥ 1".into(),
+        ));
+    }
+    if let Some(dir) = &opts.out_dir {
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+    }
+    let mut scene = Scene::load(opts.scene.clone())?;
+    let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
+    let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
+    let mut reference = None;
+    let mut rows = Vec::new();
+    for &chain in &opts.chains {
+        scene.file.skin.chain = chain;
+        let names: Vec<String> = std::iter::once("irradiance".to_string())
+            .chain((1..=6).map(|k| format!("blur{k}")))
+            .collect();
+        let images = stored_images(ctx, &scene, &names)?;
+        let levels: Vec<Level> = images.into_iter().map(Level::from).collect();
+        let reference = match &mut reference {
+            Some(r) => r,
+            None => reference.insert(exact(&scene, &skin, &levels[0], opts.stride)?),
+        };
+        let diffused: Vec<Vec3> = reference
+            .texels
+            .iter()
+            .zip(&reference.irradiance)
+            .map(|(t, &e)| {
+                let blurred: Vec3 = levels[1..]
+                    .iter()
+                    .zip(&weights)
+                    .map(|(level, w)| *w * level.at(t.uv).unwrap_or(e))
+                    .sum();
+                e.lerp(blurred, skin.blur_amount)
+            })
+            .collect();
+        let name = format!("{chain:?}").to_lowercase();
+        let rgba =
+            |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|c| c.extend(1.0).to_array()).collect() };
+        let (want, got) = (rgba(&reference.diffused), rgba(&diffused));
+        let regions = reference
+            .masks
+            .iter()
+            .filter(|(_, mask)| mask.contains(&true))
+            .map(|(region, mask)| {
+                Ok(RegionRow {
+                    region: region.clone(),
+                    error: relative(&want, &got, mask)?,
+                    bias_rgb: bias(&reference.diffused, &diffused, mask),
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(dir) = &opts.out_dir {
+            let side = skin.resolution.div_ceil(opts.stride);
+            let image = |values: &[Vec3]| {
+                let mut out = vec![0.0f32; 4 * (side * side) as usize];
+                for (t, v) in reference.texels.iter().zip(values) {
+                    let i = 4 * ((t.y / opts.stride) * side + t.x / opts.stride) as usize;
+                    out[i..i + 4].copy_from_slice(&v.extend(1.0).to_array());
+                }
+                out
+            };
+            let error: Vec<Vec3> = reference
+                .diffused
+                .iter()
+                .zip(&diffused)
+                .map(|(r, d)| (*d - *r) / r.max(Vec3::splat(1e-6)))
+                .collect();
+            if rows.is_empty() {
+                write_exr(
+                    &dir.join("reference.exr"),
+                    side,
+                    side,
+                    &image(&reference.diffused),
+                )?;
+                write_rgba8_png(
+                    &dir.join("regions.png"),
+                    side,
+                    side,
+                    &region_colours(reference, side, opts.stride),
+                )?;
+            }
+            write_exr(
+                &dir.join(format!("{name}.exr")),
+                side,
+                side,
+                &image(&diffused),
+            )?;
+            write_exr(
+                &dir.join(format!("{name}-error.exr")),
+                side,
+                side,
+                &image(&error),
+            )?;
+        }
+        let row = DiffusionRow {
+            environment: scene.file.environment.source.to_string(),
+            chain: name,
+            resolution: skin.resolution,
+            stride: opts.stride,
+            regions,
+            reference_seconds: reference.seconds,
+        };
+        progress(&row);
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// A read-back level: coverage-premultiplied RGBA, sampled as the final pass
+/// does (bilinear at the texel's UV, divided by coverage).
+struct Level {
+    width: u32,
+    height: u32,
+    rgba: Vec<f32>,
+}
+
+impl From<(u32, u32, Vec<f32>)> for Level {
+    fn from((width, height, rgba): (u32, u32, Vec<f32>)) -> Self {
+        Level {
+            width,
+            height,
+            rgba,
+        }
+    }
+}
+
+impl Level {
+    fn at(&self, uv: Vec2) -> Option<Vec3> {
+        let c = bilinear(self.width, self.height, uv, |x, y| {
+            let i = 4 * (y as usize * self.width as usize + x as usize);
+            Vec4::from_slice(&self.rgba[i..i + 4])
+        });
+        (c.w > MIN_COVERAGE).then(|| c.truncate() / c.w)
+    }
+}
+
+/// The exact diffusion at the covered texels of the irradiance, and the masks.
+fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) -> Result<Reference> {
+    let mesh = &scene.mesh;
+    let texels = texels(
+        &mesh.positions,
+        &mesh.normals,
+        &mesh.uvs,
+        &mesh.indices,
+        irradiance.width,
+        stride,
+    );
+    if texels.is_empty() {
+        return Err(Error::Input(
+            "reference --diffusion: the mesh covers no texel".into(),
+        ));
+    }
+    let variances: Vec<f32> = skin
+        .profile
+        .gaussians
+        .iter()
+        .map(|g| g.variance_mm2)
+        .collect();
+    let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
+    let e: Vec<Vec3> = texels
+        .iter()
+        .map(|t| irradiance.at(t.uv).unwrap_or(Vec3::ZERO))
+        .collect();
+    let scale = e.iter().map(|e| e.max_element()).sum::<f32>() / e.len() as f32;
+    let diffusion = Diffusion::new(&mesh.positions, &mesh.uvs, &mesh.indices, &variances)?
+        .with_irradiance_scale(scale);
+    let edges = MeshEdges::new(
+        &mesh.positions,
+        &mesh.uvs,
+        &mesh.indices,
+        diffusion.extent(),
+    );
+    let task = Task::new("exact diffusion", texels.len() as u64);
+    let start = Instant::now();
+    let lookup = |uv: Vec2| irradiance.at(uv);
+    let diffused: Vec<Vec3> = texels
+        .par_iter()
+        .zip(&e)
+        .map(|(t, &e)| {
+            let s = diffusion.at(t.position, &lookup);
+            let open = edges.to_open(t.position);
+            let reach = diffusion.reach();
+            let d = s.diffuse(&weights, |k| open.is_some_and(|o| o < reach[k]));
+            task.add(1);
+            e.lerp(d, skin.blur_amount)
+        })
+        .collect();
+    let seconds = start.elapsed().as_secs_f64();
+    drop(task);
+    let ids = region_ids(scene, &texels);
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let neck = REGION_NAMES.len() - 1;
+    let mut masks = vec![("face".to_string(), ids.iter().map(|&i| i != neck).collect())];
+    masks.extend(
+        REGION_NAMES
+            .iter()
+            .enumerate()
+            .map(|(k, name)| (name.to_string(), ids.iter().map(|&i| i == k).collect())),
+    );
+    masks.push((
+        format!("UV seams (≤ {SEAM_MM} mm)"),
+        texels
+            .iter()
+            .map(|t| edges.to_seam(t.position).is_some_and(|d| d <= SEAM_MM))
+            .collect(),
+    ));
+    masks.push((
+        format!("scattering > {:.0} %", 100.0 * SCATTERING_CHANGE),
+        diffused
+            .iter()
+            .zip(&e)
+            .map(|(&d, &e)| (lum(d) - lum(e)).abs() > SCATTERING_CHANGE * lum(d))
+            .collect(),
+    ));
+    masks.push(("all".to_string(), vec![true; texels.len()]));
+    Ok(Reference {
+        texels,
+        irradiance: e,
+        diffused,
+        masks,
+        region: ids,
+        seconds,
+    })
+}
+
+/// The face region (skin::specular::REGION_NAMES) of each texel: from the
+/// scene's region map where it has one (a file's, or the built-in head's), else
+/// from the mesh by [`landmark_region`].
+fn region_ids(scene: &Scene, texels: &[Texel]) -> Vec<usize> {
+    let last = REGION_NAMES.len() - 1;
+    if scene.file.textures.regions.is_none() && scene.file.mesh.is_some() {
+        let nose = scene
+            .mesh
+            .positions
+            .iter()
+            .copied()
+            .reduce(|a, b| if b.z > a.z { b } else { a })
+            .unwrap_or_default();
+        return texels
+            .iter()
+            .map(|t| landmark_region(t.position - nose))
+            .collect();
+    }
+    let r = &scene.regions;
+    texels
+        .iter()
+        .map(|t| {
+            let p = (t.uv * Vec2::new(r.width as f32, r.height as f32)).as_uvec2();
+            let i = 4 * (p.y.min(r.height - 1) * r.width + p.x.min(r.width - 1)) as usize;
+            (r.rgba8[i] as usize).min(last)
+        })
+        .collect()
+}
+
+/// The face region of a point `d` mm from the nose tip (the mesh's most +z
+/// point) of a head looking along +z, y up: boxes about the tip sized for an
+/// adult face (nasal bridge ~50 mm, tip to mouth ~35 mm, ears ~75 mm to the
+/// side), checked by eye on the scan (docs/skin.md shows the masks).
+pub fn landmark_region(d: Vec3) -> usize {
+    let (x, y, z) = (d.x.abs(), d.y, d.z);
+    let within = |v: f32, lo: f32, hi: f32| (lo..=hi).contains(&v);
+    let region = |name: &str| {
+        REGION_NAMES
+            .iter()
+            .position(|n| *n == name)
+            .expect("a region")
+    };
+    if x > 75.0 && within(y, -25.0, 50.0) && within(z, -180.0, -95.0) {
+        region("ears")
+    } else if x < 17.0 && within(y, -22.0, 32.0) && z > -32.0 {
+        region("nose")
+    } else if within(x, 12.0, 52.0) && within(y, 22.0, 50.0) && z > -55.0 {
+        region("eyelids/around eyes")
+    } else if x < 50.0 && within(y, 50.0, 110.0) && z > -65.0 {
+        region("forehead")
+    } else if x < 27.0 && within(y, -35.0, -18.0) && z > -40.0 {
+        region("upper lip")
+    } else if x < 27.0 && within(y, -52.0, -35.0) && z > -45.0 {
+        region("lower lip")
+    } else if x < 30.0 && within(y, -90.0, -52.0) && z > -60.0 {
+        region("chin")
+    } else if within(x, 17.0, 65.0) && within(y, -40.0, 22.0) && z > -75.0 {
+        region(if d.x > 0.0 {
+            "left cheek"
+        } else {
+            "right cheek"
+        })
+    } else {
+        REGION_NAMES.len() - 1
+    }
+}
+
+/// Each texel's region as a colour (UV space, rows in v's order; uncovered
+/// texels black), to check the masks by eye.
+fn region_colours(reference: &Reference, side: u32, stride: u32) -> Vec<u8> {
+    const PALETTE: [[u8; 3]; 10] = [
+        [230, 25, 75],
+        [60, 180, 75],
+        [255, 225, 25],
+        [0, 130, 200],
+        [245, 130, 48],
+        [145, 30, 180],
+        [70, 240, 240],
+        [240, 50, 230],
+        [210, 245, 60],
+        [128, 128, 128],
+    ];
+    let mut out = vec![0u8; 4 * (side * side) as usize];
+    for (t, &id) in reference.texels.iter().zip(&reference.region) {
+        let i = 4 * ((t.y / stride) * side + t.x / stride) as usize;
+        out[i..i + 3].copy_from_slice(&PALETTE[id % PALETTE.len()]);
+        out[i + 3] = 255;
+    }
+    out
+}
+
+/// Σ(got − want)/Σ want per channel over `mask`: the chain's colour bias.
+fn bias(want: &[Vec3], got: &[Vec3], mask: &[bool]) -> [f64; 3] {
+    let (w, g) = want.iter().zip(got).zip(mask).filter(|(_, &m)| m).fold(
+        (glam::DVec3::ZERO, glam::DVec3::ZERO),
+        |(w, g), ((a, b), _)| (w + a.as_dvec3(), g + b.as_dvec3()),
+    );
+    ((g - w) / w.max(glam::DVec3::splat(1e-30))).to_array()
+}
+
+/// The rows as a Markdown table (percentages).
+pub fn table(rows: &[DiffusionRow]) -> String {
+    let pct = |v: f64| format!("{:.1} %", 100.0 * v);
+    let mut out = String::from(
+        "| environment | chain | region | texels | mean | median | p90 | bias R | bias G | bias B |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        for g in &r.regions {
+            out += &format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                r.environment,
+                r.chain,
+                g.region,
+                g.error.pixels,
+                pct(g.error.mean),
+                pct(g.error.median),
+                pct(g.error.p90),
+                pct(g.bias_rgb[0]),
+                pct(g.bias_rgb[1]),
+                pct(g.bias_rgb[2]),
+            );
+        }
+    }
+    out
+}
