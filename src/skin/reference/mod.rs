@@ -80,7 +80,9 @@ impl<'a> Diffusion<'a> {
                 uvs.len()
             )));
         }
-        if indices.len() % 3 != 0 || indices.iter().any(|&i| i as usize >= positions.len()) {
+        if !indices.len().is_multiple_of(3)
+            || indices.iter().any(|&i| i as usize >= positions.len())
+        {
             return Err(Error::Input(
                 "exact diffusion: indices are not triangles of the mesh's vertices".into(),
             ));
