@@ -138,38 +138,6 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: ReferenceArgs,
-    }
-
-    #[test]
-    fn env_repeats_and_the_image_is_small_by_default() {
-        let cli = Cli::try_parse_from(["dermis", "--env", "sky", "--env", "uniform:1"]).unwrap();
-        let s = cli.args.scene;
-        assert_eq!(s.envs.len(), 2);
-        assert_eq!(s.envs[1], "uniform:1".parse().unwrap());
-        assert_eq!(s.overrides.env, None);
-        assert_eq!(
-            (s.overrides.width, s.overrides.height),
-            (Some(96), Some(120))
-        );
-        let cli = Cli::try_parse_from(["dermis", "--width", "64", "--exposure", "1"]).unwrap();
-        let s = cli.args.scene;
-        assert!(s.envs.is_empty());
-        assert_eq!(
-            (s.overrides.width, s.overrides.exposure),
-            (Some(64), Some(1.0))
-        );
-    }
-}
-
 /// `dermis reference --diffusion`.
 fn diffusion(
     file: dermis::scene::file::SceneFile,
@@ -211,4 +179,36 @@ fn diffusion(
         print!("{}", d::table(&rows));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: ReferenceArgs,
+    }
+
+    #[test]
+    fn env_repeats_and_the_image_is_small_by_default() {
+        let cli = Cli::try_parse_from(["dermis", "--env", "sky", "--env", "uniform:1"]).unwrap();
+        let s = cli.args.scene;
+        assert_eq!(s.envs.len(), 2);
+        assert_eq!(s.envs[1], "uniform:1".parse().unwrap());
+        assert_eq!(s.overrides.env, None);
+        assert_eq!(
+            (s.overrides.width, s.overrides.height),
+            (Some(96), Some(120))
+        );
+        let cli = Cli::try_parse_from(["dermis", "--width", "64", "--exposure", "1"]).unwrap();
+        let s = cli.args.scene;
+        assert!(s.envs.is_empty());
+        assert_eq!(
+            (s.overrides.width, s.overrides.exposure),
+            (Some(64), Some(1.0))
+        );
+    }
 }
