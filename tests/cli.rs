@@ -1043,3 +1043,28 @@ fn the_cpu_reference_reports_progress_and_convergence() {
     }
     assert!(stderr.contains("converged to 0.5 %"), "{stderr}");
 }
+
+#[test]
+fn reference_diffusion_refuses_bad_input() {
+    for (args, needle) in [
+        (&["--stride", "0"][..], "--stride"),
+        (&["--blur-width", "0"][..], "skin.blur_width"),
+    ] {
+        let out = dermis(
+            &[
+                &["reference", "--diffusion", "--irradiance-res", "256"],
+                args,
+            ]
+            .concat(),
+        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.starts_with("error:") && l.contains(needle)),
+            "{stderr}"
+        );
+    }
+}

@@ -96,6 +96,12 @@ pub fn run(
     }
     let mut scene = Scene::load(opts.scene.clone())?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
+    if skin.profile.gaussians.iter().any(|g| g.variance_mm2 <= 0.0) {
+        return Err(Error::Input(format!(
+            "reference --diffusion: skin.blur_width {} leaves no scattering to compare",
+            scene.file.skin.blur_width
+        )));
+    }
     let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
     let mut reference = None;
     let mut rows = Vec::new();
