@@ -11,7 +11,11 @@
 use super::metric::{relative, RelativeError};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::light::reference::bilinear;
+use crate::light::occlusion::Bvh;
+use crate::light::reference::{bilinear, rgba8};
+use crate::post::meter;
+use crate::post::tonemap::encode8;
+use crate::post::{Exposure, PostSettings};
 use crate::render::output::{write_exr, write_rgba8_png};
 use crate::render::progress::Task;
 use crate::render::stored_images;
@@ -74,7 +78,20 @@ struct Reference {
     masks: Vec<(String, Vec<bool>)>,
     /// Each texel's face region.
     region: Vec<usize>,
+    /// The mesh's pixels through the scene's camera, and the exact diffusion
+    /// there.
+    pixels: Vec<Pixel>,
+    pixel_diffused: Vec<Vec3>,
     seconds: f64,
+}
+
+/// A pixel of the scene's camera that sees the mesh.
+struct Pixel {
+    index: usize,
+    uv: Vec2,
+    position: Vec3,
+    /// albedo^(1−mix)/π: what the final pass multiplies the diffused irradiance by.
+    shade: Vec3,
 }
 
 /// Runs the comparison for every chain of `opts`.
@@ -129,11 +146,24 @@ pub fn run(
                 e.lerp(blurred, skin.blur_amount)
             })
             .collect();
+        let pixel_diffused: Vec<Vec3> = reference
+            .pixels
+            .iter()
+            .map(|p| {
+                let e = levels[0].at(p.uv).unwrap_or(Vec3::ZERO);
+                let blurred: Vec3 = levels[1..]
+                    .iter()
+                    .zip(&weights)
+                    .map(|(level, w)| *w * level.at(p.uv).unwrap_or(e))
+                    .sum();
+                e.lerp(blurred, skin.blur_amount)
+            })
+            .collect();
         let name = format!("{chain:?}").to_lowercase();
         let rgba =
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|c| c.extend(1.0).to_array()).collect() };
         let (want, got) = (rgba(&reference.diffused), rgba(&diffused));
-        let regions = reference
+        let mut regions = reference
             .masks
             .iter()
             .filter(|(_, mask)| mask.contains(&true))
@@ -145,6 +175,72 @@ pub fn run(
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        // The diffuse term through the camera, shaded as the final pass.
+        let (w, h) = (scene.file.render.width, scene.file.render.height);
+        let screen = |values: &[Vec3]| {
+            let mut out = vec![0.0f32; 4 * (w * h) as usize];
+            for (p, v) in reference.pixels.iter().zip(values) {
+                out[4 * p.index..4 * p.index + 4]
+                    .copy_from_slice(&(p.shade * *v).extend(1.0).to_array());
+            }
+            out
+        };
+        let (screen_want, screen_got) =
+            (screen(&reference.pixel_diffused), screen(&pixel_diffused));
+        let covered: Vec<bool> = screen_want.chunks_exact(4).map(|p| p[3] > 0.5).collect();
+        if covered.contains(&true) {
+            let shaded = |v: &[Vec3]| -> Vec<Vec3> {
+                reference
+                    .pixels
+                    .iter()
+                    .zip(v)
+                    .map(|(p, v)| p.shade * *v)
+                    .collect()
+            };
+            regions.push(RegionRow {
+                region: format!("screen {w}×{h}"),
+                error: relative(&screen_want, &screen_got, &covered)?,
+                bias_rgb: bias(
+                    &shaded(&reference.pixel_diffused),
+                    &shaded(&pixel_diffused),
+                    &vec![true; reference.pixels.len()],
+                ),
+            });
+        }
+        if let Some(dir) = &opts.out_dir {
+            if rows.is_empty() {
+                write_exr(&dir.join("screen-exact.exr"), w, h, &screen_want)?;
+            }
+            write_exr(&dir.join(format!("screen-{name}.exr")), w, h, &screen_got)?;
+            // Exact | chain | 10 × |difference|, at the exact image's exposure.
+            let post = PostSettings::resolve(&scene.file.render);
+            let exposure = match post.exposure {
+                Exposure::Given(ev) => ev,
+                Exposure::Metered => meter::exposure(&screen_want).ev,
+            };
+            let difference: Vec<f32> = screen_want
+                .iter()
+                .zip(&screen_got)
+                .enumerate()
+                .map(|(i, (a, b))| if i % 4 == 3 { *a } else { 10.0 * (a - b).abs() })
+                .collect();
+            let images = [&screen_want, &screen_got, &difference]
+                .map(|i| encode8(i, exposure, &post.display));
+            let row_bytes = 4 * w as usize;
+            let side_by_side: Vec<u8> = (0..h as usize)
+                .flat_map(|y| {
+                    images
+                        .iter()
+                        .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
+                })
+                .collect();
+            write_rgba8_png(
+                &dir.join(format!("screen-exact-{name}-difference.png")),
+                3 * w,
+                h,
+                &side_by_side,
+            )?;
+        }
         if let Some(dir) = &opts.out_dir {
             let side = skin.resolution.div_ceil(opts.stride);
             let image = |values: &[Vec3]| {
@@ -266,20 +362,26 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         &mesh.indices,
         diffusion.extent(),
     );
-    let task = Task::new("exact diffusion", texels.len() as u64);
+    let pixels = pixels(scene, skin);
+    let task = Task::new("exact diffusion", (texels.len() + pixels.len()) as u64);
     let start = Instant::now();
     let lookup = |uv: Vec2| irradiance.at(uv);
+    let exact = |position: Vec3, e: Vec3| {
+        let s = diffusion.at(position, &lookup);
+        let open = edges.to_open(position);
+        let reach = diffusion.reach();
+        let d = s.diffuse(&weights, |k| open.is_some_and(|o| o < reach[k]));
+        task.add(1);
+        e.lerp(d, skin.blur_amount)
+    };
     let diffused: Vec<Vec3> = texels
         .par_iter()
         .zip(&e)
-        .map(|(t, &e)| {
-            let s = diffusion.at(t.position, &lookup);
-            let open = edges.to_open(t.position);
-            let reach = diffusion.reach();
-            let d = s.diffuse(&weights, |k| open.is_some_and(|o| o < reach[k]));
-            task.add(1);
-            e.lerp(d, skin.blur_amount)
-        })
+        .map(|(t, &e)| exact(t.position, e))
+        .collect();
+    let pixel_diffused: Vec<Vec3> = pixels
+        .par_iter()
+        .map(|p| exact(p.position, irradiance.at(p.uv).unwrap_or(Vec3::ZERO)))
         .collect();
     let seconds = start.elapsed().as_secs_f64();
     drop(task);
@@ -315,8 +417,44 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         diffused,
         masks,
         region: ids,
+        pixels,
+        pixel_diffused,
         seconds,
     })
+}
+
+/// The pixels of the scene's camera (render.width × render.height) that see
+/// the mesh, by ray casting (light::occlusion::Bvh), as the final pass shades
+/// them.
+fn pixels(scene: &Scene, skin: &SkinSettings) -> Vec<Pixel> {
+    let (w, h) = (scene.file.render.width, scene.file.render.height);
+    let mesh = &scene.mesh;
+    let bvh = Bvh::from_mesh(mesh);
+    let inv = scene.camera.view_projection(w as f32 / h as f32).inverse();
+    (0..w * h)
+        .into_par_iter()
+        .filter_map(|i| {
+            let ndc = Vec2::new(
+                ((i % w) as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                ((i / w) as f32 + 0.5) / h as f32 * 2.0 - 1.0,
+            );
+            let near = inv.project_point3(ndc.extend(0.0));
+            let far = inv.project_point3(ndc.extend(1.0));
+            let hit = bvh.closest_hit(near, far - near, 1.0)?;
+            let k = 3 * hit.triangle as usize;
+            let corner = |c: usize| mesh.indices[k + c] as usize;
+            let b = hit.barycentric.to_array();
+            let uv: Vec2 = (0..3).map(|c| b[c] * mesh.uvs[corner(c)]).sum();
+            let position: Vec3 = (0..3).map(|c| b[c] * mesh.positions[corner(c)]).sum();
+            let albedo = rgba8(&scene.albedo, uv).truncate();
+            Some(Pixel {
+                index: i as usize,
+                uv,
+                position,
+                shade: albedo.powf(1.0 - skin.mix) / std::f32::consts::PI,
+            })
+        })
+        .collect()
 }
 
 /// The face region (skin::specular::REGION_NAMES) of each texel: from the

@@ -26,4 +26,4 @@ pub use env_sampler::{luminance, EnvSampler};
 pub use image::{render_view, render_view_with, ReferenceImage};
 pub use integrate::{Estimate, Settings};
 pub use per_vertex::per_vertex;
-pub use texture::bilinear;
+pub use texture::{bilinear, rgba8};
