@@ -263,6 +263,7 @@ pub fn sheet_views() -> Vec<View> {
         Screen::Debug(crate::post::debug::DebugView::Depth),
         Screen::Direct(crate::light::direct::DirectView::Occlusion),
         Screen::Skin(crate::skin::shade::ShadeMode::Specular),
+        Screen::Skin(crate::skin::shade::ShadeMode::Transmission),
     ];
     stretch
         .chain(blur)
