@@ -208,6 +208,10 @@ fn transmission_zero_or_a_light_in_front_adds_nothing() {
         let front = LightSource::Directional(Vec3::new(0.2, 0.1, 1.0).normalize());
         let with = render(ctx, &scene(1.0, front, 1.0), "final");
         let without = render(ctx, &scene(1.0, front, 0.0), "final");
+        // The lit face's own radiance, E·cos θ·albedo/π: what the same albedo
+        // and readback give without the transmission (printed for docs/skin.md).
+        let lit = E * Vec3::new(0.2, 0.1, 1.0).normalize().z * ALBEDO / PI;
+        println!("front-lit radiance / E·cos θ·albedo/π = {}", centre(&with) / lit);
         assert!(centre(&with).x > 1.0, "{}", centre(&with));
         assert!(bits(&with) == bits(&without), "the term changed a front-lit image");
         // Half the scale, half the term.
