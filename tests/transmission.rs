@@ -41,12 +41,48 @@ fn slab(d: f32) -> Mesh {
     // (corner, edge along u, edge along v, UV corner, UV size): e_u × e_v is
     // the outward normal.
     let faces = [
-        (Vec3::new(-a, -a, h), Vec3::new(2.0 * a, 0.0, 0.0), Vec3::new(0.0, 2.0 * a, 0.0), Vec2::new(0.02, 0.02), Vec2::splat(0.45)),
-        (Vec3::new(a, -a, -h), Vec3::new(-2.0 * a, 0.0, 0.0), Vec3::new(0.0, 2.0 * a, 0.0), Vec2::new(0.53, 0.02), Vec2::splat(0.45)),
-        (Vec3::new(a, -a, h), Vec3::new(0.0, 0.0, -d), Vec3::new(0.0, 2.0 * a, 0.0), Vec2::new(0.02, 0.53), Vec2::new(0.2, 0.45)),
-        (Vec3::new(-a, -a, -h), Vec3::new(0.0, 0.0, d), Vec3::new(0.0, 2.0 * a, 0.0), Vec2::new(0.26, 0.53), Vec2::new(0.2, 0.45)),
-        (Vec3::new(-a, a, h), Vec3::new(2.0 * a, 0.0, 0.0), Vec3::new(0.0, 0.0, -d), Vec2::new(0.52, 0.53), Vec2::new(0.2, 0.45)),
-        (Vec3::new(-a, -a, -h), Vec3::new(2.0 * a, 0.0, 0.0), Vec3::new(0.0, 0.0, d), Vec2::new(0.76, 0.53), Vec2::new(0.2, 0.45)),
+        (
+            Vec3::new(-a, -a, h),
+            Vec3::new(2.0 * a, 0.0, 0.0),
+            Vec3::new(0.0, 2.0 * a, 0.0),
+            Vec2::new(0.02, 0.02),
+            Vec2::splat(0.45),
+        ),
+        (
+            Vec3::new(a, -a, -h),
+            Vec3::new(-2.0 * a, 0.0, 0.0),
+            Vec3::new(0.0, 2.0 * a, 0.0),
+            Vec2::new(0.53, 0.02),
+            Vec2::splat(0.45),
+        ),
+        (
+            Vec3::new(a, -a, h),
+            Vec3::new(0.0, 0.0, -d),
+            Vec3::new(0.0, 2.0 * a, 0.0),
+            Vec2::new(0.02, 0.53),
+            Vec2::new(0.2, 0.45),
+        ),
+        (
+            Vec3::new(-a, -a, -h),
+            Vec3::new(0.0, 0.0, d),
+            Vec3::new(0.0, 2.0 * a, 0.0),
+            Vec2::new(0.26, 0.53),
+            Vec2::new(0.2, 0.45),
+        ),
+        (
+            Vec3::new(-a, a, h),
+            Vec3::new(2.0 * a, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -d),
+            Vec2::new(0.52, 0.53),
+            Vec2::new(0.2, 0.45),
+        ),
+        (
+            Vec3::new(-a, -a, -h),
+            Vec3::new(2.0 * a, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, d),
+            Vec2::new(0.76, 0.53),
+            Vec2::new(0.2, 0.45),
+        ),
     ];
     for (corner, eu, ev, uv0, uv_size) in faces {
         let n = eu.cross(ev).normalize();
@@ -183,7 +219,10 @@ fn a_backlit_slab_transmits_the_profile_through_its_thickness() {
             }
         }
     });
-    println!("largest relative error (channels above 1e-4): {:.3} %", 100.0 * worst);
+    println!(
+        "largest relative error (channels above 1e-4): {:.3} %",
+        100.0 * worst
+    );
 }
 
 /// Every pixel's RGBA bits.
@@ -211,9 +250,15 @@ fn transmission_zero_or_a_light_in_front_adds_nothing() {
         // The lit face's own radiance, E·cos θ·albedo/π: what the same albedo
         // and readback give without the transmission (printed for docs/skin.md).
         let lit = E * Vec3::new(0.2, 0.1, 1.0).normalize().z * ALBEDO / PI;
-        println!("front-lit radiance / E·cos θ·albedo/π = {}", centre(&with) / lit);
+        println!(
+            "front-lit radiance / E·cos θ·albedo/π = {}",
+            centre(&with) / lit
+        );
         assert!(centre(&with).x > 1.0, "{}", centre(&with));
-        assert!(bits(&with) == bits(&without), "the term changed a front-lit image");
+        assert!(
+            bits(&with) == bits(&without),
+            "the term changed a front-lit image"
+        );
         // Half the scale, half the term.
         let half = render(ctx, &scene(1.0, behind, 0.5), "transmission");
         let full = render(ctx, &scene(1.0, behind, 1.0), "transmission");

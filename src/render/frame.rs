@@ -503,7 +503,11 @@ impl Frame {
         let settings = ShadeSettings {
             weights: self.weights,
             variances: std::array::from_fn(|i| {
-                self.skin.profile.gaussians.get(i).map_or(0.0, |g| g.variance_mm2)
+                self.skin
+                    .profile
+                    .gaussians
+                    .get(i)
+                    .map_or(0.0, |g| g.variance_mm2)
             }),
             transmission: self.skin.transmission,
             mix: self.skin.mix,

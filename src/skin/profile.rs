@@ -430,7 +430,10 @@ mod tests {
             println!("T({d} mm) = {:.5} {:.6} {:.3e}", t.x, t.y, t.z);
             for c in 0..3 {
                 let err = (integral[c] - t[c] as f64).abs();
-                assert!(err <= 1e-4 * t[c] as f64 + 1e-9, "d {d} c {c}: {integral:?} vs {t}");
+                assert!(
+                    err <= 1e-4 * t[c] as f64 + 1e-9,
+                    "d {d} c {c}: {integral:?} vs {t}"
+                );
             }
         }
         // Thicker transmits less, red most (the widest Gaussians are red).
@@ -442,7 +445,10 @@ mod tests {
                 weights: Vec3::ONE,
             }],
         };
-        assert_eq!((flat.transmittance(0.0), flat.transmittance(0.1)), (Vec3::ONE, Vec3::ZERO));
+        assert_eq!(
+            (flat.transmittance(0.0), flat.transmittance(0.1)),
+            (Vec3::ONE, Vec3::ZERO)
+        );
     }
 
     #[test]
