@@ -176,7 +176,7 @@ pub fn gaussian(variance_mm2: f32, r_mm: f32) -> f32 {
 }
 
 /// exp(−d²/2v): what one Gaussian of variance v keeps through thickness d
-/// (common/transmission in skin.frag mirrors it).
+/// (`transmittance` in shaders-glsl/skin.frag mirrors it).
 fn slab_factor(variance_mm2: f32, d_mm: f32) -> f32 {
     if variance_mm2 > 0.0 {
         (-d_mm * d_mm / (2.0 * variance_mm2)).exp()
