@@ -4,6 +4,8 @@
 // post-scatter albedo^(1-mix); Lambert's 1/π turns irradiance into radiance.
 // Plus the KS specular (the paper's eq. 1) of the explicit lights and of the
 // environment (split sum: ρs·A(N·V, m) × the KS-prefiltered environment).
+// With TRANSMISSION, the light of shadowed lights behind the skin transmitted
+// through it adds to the diffuse (docs/skin.md, "Transmission").
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "envmap.glsl"
@@ -11,6 +13,8 @@ layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 #define SHADOW_ATLAS 3
 #define SOFT_VISIBILITY 18
+// Bindings 18..20: the soft lights' visibility; 21: the shadow atlas's depths.
+#define SHADOW_DEPTH 21
 #include "lights.glsl"
 // binding 4: the per-vertex transfer, read by mesh_lit.vert.
 #define ENV_SPECULAR 5
@@ -30,9 +34,21 @@ layout(binding = 12) uniform sampler2D blur6;
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
-// mode: 0 final, 1 diffuse only, 2 specular only. blur_amount: the share of the
-// blurred levels, the rest the unblurred irradiance (the paper's menu).
-layout(push_constant) uniform Push { vec4 weights[6]; float mix_pre; uint mode; float blur_amount; } pc;
+// weights: rgb the Gaussians' weights, w their variances (mm², for the
+// transmittance). mode: 0 final, 1 diffuse only, 2 specular only, 3 the
+// transmitted light only. blur_amount: the share of the blurred levels, the
+// rest the unblurred irradiance (the paper's menu). transmission: the scale on
+// the transmitted light (skin.transmission).
+layout(push_constant) uniform Push {
+    vec4 weights[6];
+    float mix_pre;
+    uint mode;
+    float blur_amount;
+    float transmission;
+} pc;
+// The pass is built with the transmitted term (skin::shade::ShadePass::new);
+// without it the shader is the one without the term.
+layout(constant_id = 5) const bool TRANSMISSION = false;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -46,6 +62,41 @@ layout(location = 0) out vec4 color;
 vec3 lookup(sampler2D t) {
     vec4 b = textureLod(t, v_uv, 0.0);
     return b.rgb / max(b.a, 1e-4);
+}
+
+// T(d) = Σ wᵢ exp(−d²/2vᵢ): the profile through a slab d mm thick, per channel
+// (G(v, √(r² + d²)) = G(v, r)·exp(−d²/2v); skin::profile::Profile::transmittance).
+vec3 transmittance(float d) {
+    vec3 t = vec3(0.0);
+    for (int k = 0; k < 6; ++k) {
+        float v = pc.weights[k].w;
+        float keep = v > 0.0 ? exp(-d * d / (2.0 * v)) : (d <= 0.0 ? 1.0 : 0.0);
+        t += pc.weights[k].rgb * keep;
+    }
+    return t;
+}
+
+// Irradiance the skin at x transmits from the shadowed lights behind it
+// (Jimenez et al. 2010; d'Eon & Luebke §14.5.3): for each light the shaded
+// side faces away from (geometric normal ng towards the viewer: dot(ng, l) < 0,
+// so a lit face, whose thickness is ≈ 0, is not lit twice), the light's
+// irradiance on the light-facing surface — its normal taken as −n, the
+// light entering less what the specular reflects there (x's own ρs, m) —
+// through the thickness the shadow map gives, × skin.transmission.
+vec3 transmitted(vec3 x, vec3 ng, vec3 n, vec2 params) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
+        if ((SHADOWED_LIGHTS & (1 << i)) == 0) continue;
+        vec3 l;
+        float dist;
+        vec3 e = light_incident(i, x, l, dist);
+        if (dot(ng, l) >= 0.0) continue;
+        float back = max(dot(-n, l), 0.0);
+        if (back <= 0.0) continue;
+        back *= diffuse_transmission(back, light_lobe(i, params));
+        sum += e * back * transmittance(shadow_thickness(i, x, dist));
+    }
+    return sum * pc.transmission;
 }
 
 void main() {
@@ -63,6 +114,14 @@ void main() {
     // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
     // §14.3), taken from the diffuse and given to the environment's specular.
     float reflected = params.x * specular_albedo(n_dot_v, params.y);
+    // The transmitted light enters with the pre-scatter albedo, as the
+    // irradiance does (x's own albedo for the far side's).
+    vec3 through = vec3(0.0);
+    if (TRANSMISSION) {
+        vec3 ng = dot(v_normal, v) < 0.0 ? -v_normal : v_normal;
+        through = transmitted(v_position, ng, n, params) * pow(albedo, vec3(pc.mix_pre));
+        diffuse += through;
+    }
     vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * (1.0 - reflected);
     vec3 spec = vec3(0.0);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
@@ -74,5 +133,9 @@ void main() {
     // visibility (1 without occlusion).
     float visibility = OCCLUSION ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
     spec += reflected * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
+    if (pc.mode == 3u) {
+        color = vec4(through * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * (1.0 - reflected), 1.0);
+        return;
+    }
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);
 }

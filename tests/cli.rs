@@ -494,6 +494,8 @@ fn bad_post_and_blur_settings_name_their_key() {
     );
     assert_bad_input(&["--blur-width", "-0.5"], "skin.blur_width = -0.5");
     assert_bad_input(&["--blur-amount", "2"], "skin.blur_amount = 2");
+    assert_bad_input(&["--transmission", "-1"], "skin.transmission = -1");
+    assert_bad_input(&["--transmission", "NaN"], "skin.transmission = NaN");
     assert_bad_input(&["--background", "2,0,0"], "render.background.r = 2");
     assert_bad_input(&["--background", "1,0"], "expected three numbers R,G,B");
     assert_bad_input(&["--glow", "maybe"], "invalid value 'maybe' for '--glow");

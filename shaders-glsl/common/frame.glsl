@@ -6,7 +6,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 light_vec[8];      // w 0: xyz direction towards the light; w 1: xyz position, mm
     vec4 light_color[8];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
     mat4 light_shadow[8];   // world → (atlas u, v, depth) after the divide by w
-    vec4 light_params[8];   // x: tan(angular radius), y: shadow depth range mm, z: m² widening
+    vec4 light_params[8];   // x: tan(angular radius), y: shadow depth range mm, z: m² widening, w: point light's shadow near plane mm
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
     vec4 params;            // x: 0 (free), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;

@@ -6,7 +6,9 @@
 // space by light_visibility.frag (light/visibility.rs), which defines
 // SHADOW_DEPTH (the atlas again, nearest, no comparison), and read back by the
 // shading passes, which define SOFT_VISIBILITY: the first of three bindings of
-// the visibility textures, three lights each, coverage-premultiplied.
+// the visibility textures, three lights each, coverage-premultiplied. The final
+// skin pass defines SHADOW_DEPTH too, for the thickness light passes through
+// (shadow_thickness: transmission).
 // Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
 
@@ -123,6 +125,48 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 }
 #endif
 
+#ifdef SHADOW_DEPTH
+// The distance (mm) light i's ray to x travels inside the mesh before reaching
+// x: from the first surface the atlas stores along that ray to x (translucent
+// shadow maps, d'Eon & Luebke §14.5.3; Jimenez et al. 2010). Looked up at x's
+// own atlas point, without the acne offsets of shadow_point (they would enter
+// the thickness); the four nearest texels' thicknesses, each clamped at 0 (a
+// texel whose surface lies behind x, or that holds none: depth 1, adds none),
+// weighted bilinearly. A directional light's depth is linear over the depth
+// range (light_params.y, mm). A point light's perspective depth z is made the
+// distance along the map's axis first, n·f/(f − z(f − n)) (near n in
+// light_params.w, f = n + range); two points on one ray from the light have
+// distances along it in the ratio of their axial distances, so the thickness
+// is dist·(1 − axial(stored)/axial(x)), dist = |light − x|
+// (light::shadow::ShadowView::thickness_mm mirrors this).
+float shadow_thickness(int i, vec3 x, float dist) {
+    vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
+    vec3 p = s.xyz / s.w;
+    vec2 size = vec2(textureSize(shadow_depth, 0));
+    // The taps stay inside this light's tile of the atlas.
+    vec2 tiles = frame.params.zw;
+    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
+    vec2 hi = lo + 1.0 / tiles - 1.0 / size;
+    vec2 uv = clamp(p.xy, lo, hi);
+    // Texels (u0, v1), (u1, v1), (u1, v0), (u0, v0).
+    vec4 z = textureGather(shadow_depth, uv, 0);
+    vec2 f = fract(uv * size - 0.5);
+    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+    float range = frame.light_params[i].y;
+    vec4 t;
+    if (frame.light_vec[i].w > 0.5) {
+        float near = frame.light_params[i].w;
+        float far = near + range;
+        vec4 axial = near * far / (far - z * range);
+        float axial_x = near * far / (far - p.z * range);
+        t = dist * (1.0 - axial / axial_x);
+    } else {
+        t = (p.z - z) * range;
+    }
+    return dot(w, max(t, vec4(0.0)));
+}
+#endif
+
 #ifdef SOFT_VISIBILITY
 layout(binding = SOFT_VISIBILITY) uniform sampler2D soft_visibility0;
 layout(binding = SOFT_VISIBILITY + 1) uniform sampler2D soft_visibility1;
@@ -157,14 +201,13 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
     return lit / 9.0;
 }
 
-// Irradiance light i delivers at x (texture coordinate uv) to a surface facing
-// it (shadowed; mirrors scene::Light::at); l: the unit direction towards the
-// light. 0 where the shading normal n faces away from it (its shadow is not
-// looked up there).
-vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, vec2 uv, out vec3 l) {
+// Irradiance light i delivers at x to a surface facing it, unshadowed (mirrors
+// scene::Light::at); l: the unit direction towards the light; dist: the
+// distance to a point light (1 for a directional one).
+vec3 light_incident(int i, vec3 x, out vec3 l, out float dist) {
     vec4 lv = frame.light_vec[i];
     vec3 e = frame.light_color[i].rgb;
-    float dist = 1.0;
+    dist = 1.0;
     if (lv.w > 0.5) {
         vec3 d = lv.xyz - x;
         float d2 = max(dot(d, d), 1e-6);
@@ -174,6 +217,16 @@ vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, vec2 uv, out vec3 l) {
     } else {
         l = lv.xyz;
     }
+    return e;
+}
+
+// Irradiance light i delivers at x (texture coordinate uv) to a surface facing
+// it (shadowed; mirrors scene::Light::at); l: the unit direction towards the
+// light. 0 where the shading normal n faces away from it (its shadow is not
+// looked up there).
+vec3 light_irradiance(int i, vec3 x, vec3 ng, vec3 n, vec2 uv, out vec3 l) {
+    float dist;
+    vec3 e = light_incident(i, x, l, dist);
     if (dot(n, l) <= 0.0) return vec3(0.0);
     if ((SHADOWED_LIGHTS & (1 << i)) != 0) e *= shadow_visibility(i, x, ng, uv, l, dist);
     return e;

@@ -51,7 +51,8 @@ pub struct FrameUniforms {
     pub light_shadow: [[[f32; 4]; 4]; MAX_LIGHTS],
     /// x: tan of the source's angular radius (0: a point); y: the shadow map's
     /// depth range, mm (directional lights); z: what the source adds to the
-    /// specular lobe's m² (light::shadow::lobe_widening); w: 0.
+    /// specular lobe's m² (light::shadow::lobe_widening); w: a point light's
+    /// shadow near plane, mm (its depth is perspective), else 0.
     pub light_params: [[f32; 4]; MAX_LIGHTS],
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.

@@ -28,6 +28,9 @@ pub struct ShadowView {
     /// Depth range of the map, mm (far − near; depth is linear for a directional
     /// light), which the soft shadows turn blocker depths into distances with.
     pub depth_range_mm: f32,
+    /// A point light's near plane, mm from it (its depth is perspective:
+    /// [`ShadowView::thickness_mm`]); `None` for a directional light.
+    pub near_mm: Option<f32>,
 }
 
 /// Columns and rows of the atlas's grid of `tiles` square tiles: ⌊√n⌋ rows,
@@ -72,6 +75,7 @@ impl ShadowView {
                     view_proj: proj * view,
                     texel_mm: 2.0 * r / res,
                     depth_range_mm: 2.0 * r,
+                    near_mm: None,
                 })
             }
             LightSource::Point(p) => {
@@ -86,9 +90,31 @@ impl ShadowView {
                     view_proj: proj * view,
                     texel_mm: 2.0 * half.tan() / res,
                     depth_range_mm: 2.0 * r,
+                    near_mm: Some(d - r),
                 })
             }
         }
+    }
+
+    /// The distance, mm, a ray from the light travels from the surface stored
+    /// at depth `stored` to a point at depth `depth` on the same ray, `dist` mm
+    /// from a point light (unused for a directional one); 0 where the stored
+    /// surface is not in front. The CPU copy of common/lights.glsl's
+    /// `shadow_thickness` for one texel: a directional light's depth is linear
+    /// over the range; a point light's perspective depth z is made the distance
+    /// along the axis, n·f/(f − z(f − n)), and distances along one ray are in
+    /// the ratio of the axial distances.
+    pub fn thickness_mm(&self, stored: f32, depth: f32, dist: f32) -> f32 {
+        let range = self.depth_range_mm;
+        let t = match self.near_mm {
+            None => (depth - stored) * range,
+            Some(near) => {
+                let far = near + range;
+                let axial = |z: f32| near * far / (far - z * range);
+                dist * (1.0 - axial(stored) / axial(depth))
+            }
+        };
+        t.max(0.0)
     }
 
     /// World to (atlas u, v, depth) after the divide by w, for tile `tile` of
@@ -247,6 +273,39 @@ mod tests {
             assert!(project(m, c).z < project(m, c - towards * r).z);
         }
         assert!(ShadowView::fit(LightSource::Point(c), c, r, 1024).is_none());
+    }
+
+    /// What the transmission reads: the distance between two points on one
+    /// ray from the light, from their depths alone, for both kinds of light.
+    #[test]
+    fn thickness_from_depths_is_the_distance_along_the_ray() {
+        let (c, r) = (Vec3::new(10.0, 20.0, -5.0), 100.0);
+        let point = c + Vec3::new(300.0, 100.0, 400.0);
+        for light in [
+            LightSource::Directional(Vec3::new(0.3, 0.8, 0.5).normalize()),
+            LightSource::Point(point),
+        ] {
+            let v = ShadowView::fit(light, c, r, 1024).unwrap();
+            let m = v.atlas_matrix(0, 1);
+            // A ray through the sphere, off the map's axis.
+            let entry = c + Vec3::new(20.0, -30.0, 10.0);
+            let dir = match light {
+                LightSource::Directional(d) => -d,
+                LightSource::Point(p) => (entry - p).normalize(),
+            };
+            for d in [0.5f32, 1.0, 2.0, 5.0, 40.0] {
+                let x = entry + dir * d;
+                let (front, back) = (project(m, entry), project(m, x));
+                assert!((front.truncate() - back.truncate()).length() < 1e-5);
+                let dist = match light {
+                    LightSource::Point(p) => p.distance(x),
+                    LightSource::Directional(_) => 1.0,
+                };
+                let t = v.thickness_mm(front.z, back.z, dist);
+                assert!((t - d).abs() < 2e-3 * d.max(1.0), "{light:?}: {t} for {d}");
+                assert_eq!(v.thickness_mm(back.z, front.z, dist), 0.0);
+            }
+        }
     }
 
     #[test]

@@ -73,6 +73,9 @@ pub struct RunSetup {
     pub blur_width: f32,
     /// Share of the blurred irradiance in the diffuse term.
     pub blur_amount: f32,
+    /// Scale on the light transmitted through thin skin (`skin.transmission`;
+    /// 0: off, and in reports written before the term existed).
+    pub transmission: f32,
     /// The test texture replaced the albedo.
     pub test_texture: bool,
     /// Output transfer: `srgb` or a power (`2.2`).

@@ -99,6 +99,7 @@ fn frame_uniforms(
             u.light_color[i][3] = v.texel_mm;
             u.light_shadow[i] = v.atlas_matrix(tile, tiles).to_cols_array_2d();
             u.light_params[i][1] = v.depth_range_mm;
+            u.light_params[i][3] = v.near_mm.unwrap_or(0.0);
             tile += 1;
         }
         u.env[2] = (i + 1) as f32;
@@ -204,7 +205,7 @@ impl Passes {
             stretch: StretchMaps::new(p, res, &skin.profile, constant_stretch)?,
             irradiance: IrradiancePass::new(p, variant)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone())?,
-            shade: ShadePass::new(p, variant)?,
+            shade: ShadePass::new(p, variant, skin.transmission > 0.0)?,
             shadow: ShadowPass::new(p, &lighting.views, lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,
             prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
@@ -501,6 +502,14 @@ impl Frame {
         skybox::pass(g, &self.pipelines, inputs, hdr, self.post.skybox)?;
         let settings = ShadeSettings {
             weights: self.weights,
+            variances: std::array::from_fn(|i| {
+                self.skin
+                    .profile
+                    .gaussians
+                    .get(i)
+                    .map_or(0.0, |g| g.variance_mm2)
+            }),
+            transmission: self.skin.transmission,
             mix: self.skin.mix,
             blur_amount: self.skin.blur_amount,
             mode,

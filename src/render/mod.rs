@@ -136,6 +136,7 @@ fn setup(
         },
         blur_width: f.skin.blur_width,
         blur_amount: f.skin.blur_amount,
+        transmission: f.skin.transmission,
         test_texture: f.textures.test_texture || *view == View::Screen(Screen::TestTexture),
         gamma: match f.render.gamma {
             Gamma::Srgb => "srgb".into(),
@@ -263,6 +264,7 @@ pub fn sheet_views() -> Vec<View> {
         Screen::Debug(crate::post::debug::DebugView::Depth),
         Screen::Direct(crate::light::direct::DirectView::Occlusion),
         Screen::Skin(crate::skin::shade::ShadeMode::Specular),
+        Screen::Skin(crate::skin::shade::ShadeMode::Transmission),
     ];
     stretch
         .chain(blur)

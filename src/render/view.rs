@@ -12,7 +12,8 @@ use crate::skin::shade::ShadeMode;
 /// A view with shading of its own: the pass that writes its screen image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Screen {
-    /// The skin pass: the final image, or its diffuse or specular term alone.
+    /// The skin pass: the final image, or its diffuse, specular or transmitted
+    /// term alone.
     Skin(ShadeMode),
     /// Direct diffuse shading in screen space (no scattering), or the
     /// per-vertex occlusion relative to open sky.
@@ -135,7 +136,7 @@ mod tests {
     #[test]
     fn names_round_trip() {
         let names: Vec<_> = Screen::all().map(Screen::name).collect();
-        assert_eq!(names.len(), 11, "{names:?}");
+        assert_eq!(names.len(), 12, "{names:?}");
         for s in Screen::all() {
             assert_eq!(View::parse(s.name()).unwrap(), View::Screen(s));
         }

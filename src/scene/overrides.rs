@@ -150,6 +150,10 @@ overrides! {
     /// paper's blurring amount; 0: unblurred), replacing `skin.blur_amount`.
     #[arg(allow_hyphen_values = true)]
     blur_amount: f32 => skin.blur_amount, example "0.25";
+    /// Scale (≥ 0) on the light transmitted through thin skin (ears, nostrils)
+    /// from shadowed lights behind it; 0: off. Replaces `skin.transmission`.
+    #[arg(allow_hyphen_values = true)]
+    transmission: f32 => skin.transmission, example "0.5";
     /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     test_texture: bool => textures.test_texture, example "on";

@@ -53,6 +53,11 @@ pub struct SkinSettings {
     /// Scale tap spacing by the per-texel stretch map; off: one constant
     /// texels-per-mm for the whole mesh.
     pub stretch_correction: bool,
+    /// Scale on the light transmitted through thin skin from shadowed lights
+    /// behind it (`skin.transmission`, ≥ 0; 0: the final pass is built without
+    /// the term). The profile's weights and variances give its transmittance
+    /// ([`profile::Profile::transmittance`]).
+    pub transmission: f32,
 }
 
 impl SkinSettings {
@@ -104,6 +109,7 @@ impl SkinSettings {
             mix: skin.mix,
             resolution: render.irradiance_resolution,
             stretch_correction: skin.stretch_correction,
+            transmission: skin.transmission,
         })
     }
 }

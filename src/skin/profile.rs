@@ -139,6 +139,19 @@ impl Profile {
             .sum()
     }
 
+    /// Transmittance through a slab of thickness `d_mm` (translucent shadow maps,
+    /// d'Eon & Luebke §14.5.3; Jimenez et al. 2010): light entering at a point
+    /// of the far surface and leaving r away on the near one travels
+    /// √(r² + d²), and G(v, √(r² + d²)) = G(v, r)·exp(−d²/2v), so the profile
+    /// integrated over the near surface is T(d) = Σ wᵢ exp(−d²/2vᵢ) per channel
+    /// (1 at d = 0). A zero variance (blur width 0) transmits only at d = 0.
+    pub fn transmittance(&self, d_mm: f32) -> Vec3 {
+        self.gaussians
+            .iter()
+            .map(|g| g.weights * slab_factor(g.variance_mm2, d_mm))
+            .sum()
+    }
+
     /// Standard deviations (mm) of the incremental blurs of the chain:
     /// σ_k = √(v_k − v_{k−1}) with v_0 = 0, so that blurring blur k−1 by σ_k
     /// gives blur k (eq. 5: G(v₁) * G(v₂) = G(v₁ + v₂)). Assumes ascending
@@ -160,6 +173,18 @@ impl Profile {
 /// v in mm², r in mm; integrates to 1 over the plane.
 pub fn gaussian(variance_mm2: f32, r_mm: f32) -> f32 {
     (-r_mm * r_mm / (2.0 * variance_mm2)).exp() / (2.0 * PI * variance_mm2)
+}
+
+/// exp(−d²/2v): what one Gaussian of variance v keeps through thickness d
+/// (`transmittance` in shaders-glsl/skin.frag mirrors it).
+fn slab_factor(variance_mm2: f32, d_mm: f32) -> f32 {
+    if variance_mm2 > 0.0 {
+        (-d_mm * d_mm / (2.0 * variance_mm2)).exp()
+    } else if d_mm <= 0.0 {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 /// d'Eon's 7-tap offsets, in units of σ (GPU Gems 3 §14.5, convolution shader).
@@ -381,6 +406,49 @@ mod tests {
         for (c, t) in total.iter().enumerate() {
             assert!((t - 1.0).abs() < 1e-3, "channel {c}: ∫R = {t}");
         }
+    }
+
+    #[test]
+    fn transmittance_is_the_profile_through_a_slab() {
+        let p = Profile::skin();
+        assert!((p.transmittance(0.0) - Vec3::ONE).abs().max_element() < 1e-3);
+        // Integrating the 3-D profile over the plane at distance d (polar
+        // coordinates, r to 60 mm) gives the same as the closed form.
+        for d in [0.5f32, 1.0, 2.0, 5.0] {
+            let (n, r_max) = (60_000, 60.0f64);
+            let dr = r_max / n as f64;
+            let mut integral = [0.0f64; 3];
+            for k in 0..n {
+                let r = (k as f64 + 0.5) * dr;
+                let dist = (r * r + (d as f64).powi(2)).sqrt() as f32;
+                let radial = p.radial(dist);
+                for (c, v) in integral.iter_mut().enumerate() {
+                    *v += 2.0 * std::f64::consts::PI * r * radial[c] as f64 * dr;
+                }
+            }
+            let t = p.transmittance(d);
+            println!("T({d} mm) = {:.5} {:.6} {:.3e}", t.x, t.y, t.z);
+            for c in 0..3 {
+                let err = (integral[c] - t[c] as f64).abs();
+                assert!(
+                    err <= 1e-4 * t[c] as f64 + 1e-9,
+                    "d {d} c {c}: {integral:?} vs {t}"
+                );
+            }
+        }
+        // Thicker transmits less, red most (the widest Gaussians are red).
+        let (a, b) = (p.transmittance(1.0), p.transmittance(2.0));
+        assert!(b.cmplt(a).all() && b.x > b.y && b.y > b.z);
+        let flat = Profile {
+            gaussians: vec![Gaussian {
+                variance_mm2: 0.0,
+                weights: Vec3::ONE,
+            }],
+        };
+        assert_eq!(
+            (flat.transmittance(0.0), flat.transmittance(0.1)),
+            (Vec3::ONE, Vec3::ZERO)
+        );
     }
 
     #[test]

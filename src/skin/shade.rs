@@ -1,6 +1,7 @@
 //! Final skin shading in screen space (GPU Gems 3 §14.5; the paper's Fig. 2):
 //! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π, plus the
-//! KS specular of the lights and the environment.
+//! KS specular of the lights and the environment, and the light of shadowed
+//! lights transmitted through thin skin (docs/skin.md, "Transmission").
 
 use super::tables::SpecularTables;
 use crate::error::Result;
@@ -13,10 +14,12 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadePush {
+    /// rgb: the Gaussian's weights; w: its variance, mm² (the transmittance).
     weights: [[f32; 4]; 6],
     mix_pre: f32,
     mode: u32,
     blur_amount: f32,
+    transmission: f32,
 }
 
 /// The profile weights, albedo split and output of the final pass.
@@ -24,6 +27,12 @@ struct ShadePush {
 pub struct ShadeSettings {
     /// RGB weight of each Gaussian (the paper's Fig. 2).
     pub weights: [glam::Vec3; 6],
+    /// Each Gaussian's variance, mm² (blur width applied): the transmittance
+    /// T(d) = Σ wᵢ exp(−d²/2vᵢ) (skin::profile::Profile::transmittance).
+    pub variances: [f32; 6],
+    /// Scale on the transmitted light (SkinSettings::transmission). The pass's
+    /// pipeline has the term only when it was built with it ([`ShadePass::new`]).
+    pub transmission: f32,
     /// Pre-scatter share of the albedo.
     pub mix: f32,
     /// Share of the blurred levels in the diffuse term (SkinSettings::blur_amount).
@@ -52,10 +61,18 @@ pub enum ShadeMode {
     Full = 0,
     Diffuse = 1,
     Specular = 2,
+    /// The light of shadowed lights behind the skin transmitted through it,
+    /// as it adds to the final image (docs/skin.md, "Transmission").
+    Transmission = 3,
 }
 
 impl ShadeMode {
-    pub const ALL: [ShadeMode; 3] = [ShadeMode::Full, ShadeMode::Diffuse, ShadeMode::Specular];
+    pub const ALL: [ShadeMode; 4] = [
+        ShadeMode::Full,
+        ShadeMode::Diffuse,
+        ShadeMode::Specular,
+        ShadeMode::Transmission,
+    ];
 
     /// The view's name (`render --view`).
     pub fn name(self) -> &'static str {
@@ -63,6 +80,7 @@ impl ShadeMode {
             ShadeMode::Full => "final",
             ShadeMode::Diffuse => "diffuse",
             ShadeMode::Specular => "specular",
+            ShadeMode::Transmission => "transmission",
         }
     }
 }
@@ -75,8 +93,17 @@ pub struct ShadePass {
     pipeline: Arc<Pipeline>,
 }
 
+/// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's.
+const TRANSMISSION_CONSTANT: usize = 5;
+
 impl ShadePass {
-    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant) -> Result<Self> {
+    /// `transmission`: build the final pass with the transmitted term (a
+    /// specialization constant: without it the shader is the one without the
+    /// term, so `skin.transmission = 0` costs nothing and changes no bit).
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, transmission: bool) -> Result<Self> {
+        let mut specialization = variant.specialization().to_vec();
+        debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
+        specialization.push(u32::from(transmission));
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
@@ -88,7 +115,7 @@ impl ShadePass {
                 depth_write,
                 vertex_layout: Some(Vertex::layout()),
                 cull_mode: vk::CullModeFlags::NONE,
-                specialization: &variant.specialization(),
+                specialization: &specialization,
                 alpha_blend: false,
             })
         };
@@ -141,13 +168,17 @@ impl ShadePass {
             pass = pass.sample(v, &s.linear);
         }
         let pass = pass
+            .sample(images.shadows, &s.nearest)
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {
-                weights: settings.weights.map(|w| w.extend(0.0).into()),
+                weights: std::array::from_fn(|i| {
+                    settings.weights[i].extend(settings.variances[i]).into()
+                }),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
                 blur_amount: settings.blur_amount,
+                transmission: settings.transmission,
             });
         inputs.mesh.draw(pass);
     }

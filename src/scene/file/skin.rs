@@ -1,4 +1,4 @@
-//! `[skin]`: kernel, chain, occlusion, profile, regions, blur.
+//! `[skin]`: kernel, chain, occlusion, profile, regions, blur, transmission.
 
 use serde::{Deserialize, Serialize};
 
@@ -86,6 +86,10 @@ pub struct Skin {
     /// Share of the blurred irradiance in the diffuse term, the rest unblurred
     /// (the paper's "blurring amount"; 0: unblurred).
     pub blur_amount: f32,
+    /// Scale on the light transmitted through thin skin from shadowed lights
+    /// behind it (translucent shadow maps, docs/skin.md "Transmission"; ≥ 0,
+    /// 0: off).
+    pub transmission: f32,
 }
 
 impl Default for Skin {
@@ -100,6 +104,7 @@ impl Default for Skin {
             stretch_correction: true,
             blur_width: 1.0,
             blur_amount: 1.0,
+            transmission: 1.0,
         }
     }
 }
@@ -116,6 +121,7 @@ impl Skin {
         in_range("skin.mix", self.mix, 0.0, 1.0)?;
         in_range("skin.blur_width", self.blur_width, 0.0, MAX_BLUR_WIDTH)?;
         in_range("skin.blur_amount", self.blur_amount, 0.0, 1.0)?;
+        non_negative("skin.transmission", self.transmission)?;
         if let Some(profile) = &self.profile {
             validate_profile(profile)?;
         }

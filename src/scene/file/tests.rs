@@ -382,6 +382,9 @@ fn out_of_range_values_are_rejected_with_their_key() {
         ("[skin]\nblur_width = -1", "skin.blur_width = -1"),
         ("[skin]\nblur_width = 11", "skin.blur_width = 11"),
         ("[skin]\nblur_amount = 1.5", "skin.blur_amount = 1.5"),
+        ("[skin]\ntransmission = -1", "skin.transmission = -1"),
+        ("[skin]\ntransmission = nan", "skin.transmission = NaN"),
+        ("[skin]\ntransmission = inf", "skin.transmission = inf"),
         (
             "[render]\nglow_intensity = -1",
             "render.glow_intensity = -1",
