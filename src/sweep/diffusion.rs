@@ -18,7 +18,7 @@ use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
 use crate::render::output::{write_exr, write_rgba8_png};
 use crate::render::progress::Task;
-use crate::render::stored_images;
+use crate::render::{render_scene, stored_images, RenderOptions, View};
 use crate::scene::file::{Chain, SceneFile};
 use crate::scene::Scene;
 use crate::skin::reference::{texels, Diffusion, MeshEdges, Texel};
@@ -82,6 +82,8 @@ struct Reference {
     /// there.
     pixels: Vec<Pixel>,
     pixel_diffused: Vec<Vec3>,
+    /// The face, the ears and every pixel.
+    pixel_masks: Vec<(String, Vec<bool>)>,
     seconds: f64,
 }
 
@@ -175,37 +177,42 @@ pub fn run(
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        // The diffuse term through the camera, shaded as the final pass.
+        // The diffuse term through the camera, shaded as the final pass, the
+        // chain's with the transmitted light the final pass adds (its view).
         let (w, h) = (scene.file.render.width, scene.file.render.height);
+        let transmitted = transmitted(ctx, &scene, &skin)?;
+        let shaded = |values: &[Vec3], plus: &[f32]| -> Vec<Vec3> {
+            reference
+                .pixels
+                .iter()
+                .zip(values)
+                .map(|(p, v)| {
+                    let extra = plus.get(4 * p.index..4 * p.index + 3).map_or(Vec3::ZERO, Vec3::from_slice);
+                    p.shade * *v + extra
+                })
+                .collect()
+        };
+        let (want_px, got_px) = (shaded(&reference.pixel_diffused, &[]), shaded(&pixel_diffused, &transmitted));
         let screen = |values: &[Vec3]| {
             let mut out = vec![0.0f32; 4 * (w * h) as usize];
             for (p, v) in reference.pixels.iter().zip(values) {
-                out[4 * p.index..4 * p.index + 4]
-                    .copy_from_slice(&(p.shade * *v).extend(1.0).to_array());
+                out[4 * p.index..4 * p.index + 4].copy_from_slice(&v.extend(1.0).to_array());
             }
             out
         };
-        let (screen_want, screen_got) =
-            (screen(&reference.pixel_diffused), screen(&pixel_diffused));
-        let covered: Vec<bool> = screen_want.chunks_exact(4).map(|p| p[3] > 0.5).collect();
-        if covered.contains(&true) {
-            let shaded = |v: &[Vec3]| -> Vec<Vec3> {
-                reference
-                    .pixels
-                    .iter()
-                    .zip(v)
-                    .map(|(p, v)| p.shade * *v)
-                    .collect()
-            };
-            regions.push(RegionRow {
-                region: format!("screen {w}×{h}"),
-                error: relative(&screen_want, &screen_got, &covered)?,
-                bias_rgb: bias(
-                    &shaded(&reference.pixel_diffused),
-                    &shaded(&pixel_diffused),
-                    &vec![true; reference.pixels.len()],
-                ),
-            });
+        let (screen_want, screen_got) = (screen(&want_px), screen(&got_px));
+        for (label, mask) in &reference.pixel_masks {
+            if mask.contains(&true) {
+                let mut image_mask = vec![false; (w * h) as usize];
+                for (p, &m) in reference.pixels.iter().zip(mask) {
+                    image_mask[p.index] = m;
+                }
+                regions.push(RegionRow {
+                    region: format!("screen {w}×{h}: {label}"),
+                    error: relative(&screen_want, &screen_got, &image_mask)?,
+                    bias_rgb: bias(&want_px, &got_px, mask),
+                });
+            }
         }
         if let Some(dir) = &opts.out_dir {
             if rows.is_empty() {
@@ -386,6 +393,16 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
     let seconds = start.elapsed().as_secs_f64();
     drop(task);
     let ids = region_ids(scene, &texels);
+    let pixel_ids = region_ids(
+        scene,
+        &pixels.iter().map(|p| Texel { x: 0, y: 0, uv: p.uv, position: p.position, normal: Vec3::ZERO }).collect::<Vec<_>>(),
+    );
+    let ears = REGION_NAMES.iter().position(|n| *n == "ears").expect("a region");
+    let pixel_masks = vec![
+        ("face".to_string(), pixel_ids.iter().map(|&i| i != REGION_NAMES.len() - 1).collect()),
+        ("ears".to_string(), pixel_ids.iter().map(|&i| i == ears).collect()),
+        ("all".to_string(), vec![true; pixels.len()]),
+    ];
     let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let neck = REGION_NAMES.len() - 1;
     let mut masks = vec![("face".to_string(), ids.iter().map(|&i| i != neck).collect())];
@@ -417,6 +434,7 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         diffused,
         masks,
         region: ids,
+        pixel_masks,
         pixels,
         pixel_diffused,
         seconds,
@@ -455,6 +473,26 @@ fn pixels(scene: &Scene, skin: &SkinSettings) -> Vec<Pixel> {
             })
         })
         .collect()
+}
+
+/// The transmitted radiance the final pass adds (the `transmission` view, RGBA
+/// through the scene's camera, no glow); empty when `skin.transmission` is 0.
+fn transmitted(ctx: &Arc<Context>, scene: &Scene, skin: &SkinSettings) -> Result<Vec<f32>> {
+    if skin.transmission <= 0.0 {
+        return Ok(Vec::new());
+    }
+    let mut scene = scene.clone();
+    scene.file.render.glow = false;
+    let out = render_scene(
+        ctx,
+        &scene,
+        &RenderOptions {
+            view: View::named("transmission"),
+            hdr: true,
+            ..RenderOptions::default()
+        },
+    )?;
+    Ok(out.hdr.unwrap_or_default())
 }
 
 /// The face region (skin::specular::REGION_NAMES) of each texel: from the
