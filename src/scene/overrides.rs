@@ -150,6 +150,10 @@ overrides! {
     /// paper's blurring amount; 0: unblurred), replacing `skin.blur_amount`.
     #[arg(allow_hyphen_values = true)]
     blur_amount: f32 => skin.blur_amount, example "0.25";
+    /// Blur along the surface metric of the UVs, shear included (off: along u
+    /// and v, their scale only), replacing `skin.shear_correction`.
+    #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
+    shear_correction: bool => skin.shear_correction, example "off";
     /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     test_texture: bool => textures.test_texture, example "on";

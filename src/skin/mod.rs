@@ -52,6 +52,10 @@ pub struct SkinSettings {
     /// Scale tap spacing by the per-texel stretch map; off: one constant
     /// texels-per-mm for the whole mesh.
     pub stretch_correction: bool,
+    /// Store the UV shear in the stretch maps and blur along the surface
+    /// perpendicular of ∂P/∂u (skin::stretch::StretchTensor); off: the diagonal
+    /// only, u then v.
+    pub shear_correction: bool,
 }
 
 impl SkinSettings {
@@ -103,6 +107,7 @@ impl SkinSettings {
             mix: skin.mix,
             resolution: render.irradiance_resolution,
             stretch_correction: skin.stretch_correction,
+            shear_correction: skin.shear_correction,
         })
     }
 }
