@@ -260,6 +260,61 @@ mod tests {
         assert!((major - 1.6).abs() < 1e-4 && (minor - 0.4).abs() < 1e-4);
     }
 
+    /// The scan (assets/default.toml): how sheared its UVs are, and the range
+    /// of the stored tensor at the stretch maps' smallest and largest sides
+    /// (256: a 256² irradiance; 1024: every irradiance from 1024² to 8192²).
+    /// RGBA16F holds 3 significant digits (relative step ≤ 2⁻¹¹ after rounding)
+    /// between 6.1·10⁻⁵ and 65504.
+    #[test]
+    fn the_scans_tensor_keeps_three_digits_in_half_floats() {
+        let file = crate::scene::file::scene_by_name(None).unwrap();
+        let mesh = crate::scene::load_mesh(&file).unwrap();
+        let percentile = |v: &mut Vec<(f32, f64)>, q: f64| {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let total: f64 = v.iter().map(|x| x.1).sum();
+            let mut acc = 0.0;
+            for &(x, w) in v.iter() {
+                acc += w;
+                if acc >= q * total {
+                    return x;
+                }
+            }
+            v.last().unwrap().0
+        };
+        for side in [256.0f32, 1024.0] {
+            // Per triangle, weighted by its UV area (the texels the blur sees).
+            let (mut cos, mut u, mut v, mut shear) = (vec![], vec![], vec![], vec![]);
+            for t in mesh.indices.chunks_exact(3) {
+                let i = [t[0], t[1], t[2]].map(|i| i as usize);
+                let uv = i.map(|i| mesh.uvs[i] * side);
+                let area = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs() as f64;
+                if area < 1e-6 {
+                    continue;
+                }
+                let (a, b) = jacobian(i.map(|i| mesh.positions[i]), uv);
+                let [e, f, g] = metric(a, b);
+                let st = StretchTensor::of(a, b, true);
+                cos.push((f.abs() / (e * g).sqrt(), area));
+                u.push((st.u, area));
+                v.push((st.v, area));
+                shear.push((st.shear.abs(), area));
+            }
+            let range = |x: &mut Vec<(f32, f64)>| {
+                [0.001, 0.5, 0.999].map(|q| percentile(x, q))
+            };
+            let (ru, rv, rs) = (range(&mut u), range(&mut v), range(&mut shear));
+            println!(
+                "scan at {side}²: |cos(u, v)| median {:.2}, 90th percentile {:.2}; texels/mm \
+                 (0.1 %, 50 %, 99.9 %): u {ru:.3?}, v⊥ {rv:.3?}, |shear| {rs:.3?}",
+                percentile(&mut cos, 0.5),
+                percentile(&mut cos, 0.9),
+            );
+            for x in [ru, rv] {
+                assert!(x[0] > 1e-3 && x[2] < 1e4, "{x:?}");
+            }
+        }
+    }
+
     #[test]
     fn without_shear_the_tensor_is_the_old_stretch() {
         let a = Vec3::new(0.03, 0.0, 0.04);
