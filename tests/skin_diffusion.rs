@@ -251,7 +251,10 @@ fn sheared_plane(l: f32, cos: f32) -> (Mesh, [Vec2; 2]) {
         indices: vec![0, 1, 2, 0, 2, 3],
     };
     let texel = l / N as f32;
-    (mesh, [Vec2::new(texel, 0.0), Vec2::new(texel * cos, texel * sin)])
+    (
+        mesh,
+        [Vec2::new(texel, 0.0), Vec2::new(texel * cos, texel * sin)],
+    )
 }
 
 /// One Gaussian of σ mm (the accurate kernel, taps spaced by the unblurred
@@ -316,8 +319,14 @@ fn shear_correction_makes_sheared_uvs_isotropic() {
     let sigma = 0.6f32;
     let variance = (sigma * sigma) as f64;
     let green = |out: Vec<Vec3>| out.iter().map(|c| c.y).collect::<Vec<f32>>();
-    let on = surface_moments(&green(one_gaussian(&mesh, &impulse(100.0), sigma, true)), jacobian);
-    let off = surface_moments(&green(one_gaussian(&mesh, &impulse(100.0), sigma, false)), jacobian);
+    let on = surface_moments(
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, true)),
+        jacobian,
+    );
+    let off = surface_moments(
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, false)),
+        jacobian,
+    );
     let report = |(major, minor, cross): (f64, f64, f64)| {
         format!(
             "eigen-variances {:.4} / {:.4} σ², cross {:+.4} σ², width ratio {:.3}",
@@ -339,7 +348,11 @@ fn shear_correction_makes_sheared_uvs_isotropic() {
     assert!((cross / variance).abs() < 0.02, "on: {}", report(on));
     // Off: the u-then-v blur makes σ²(â âᵀ + b̂ b̂ᵀ), eigen-variances σ²(1 ± cos).
     let (major, minor, _) = off;
-    assert!((major / minor).sqrt() > 1.8, "off should be anisotropic: {}", report(off));
+    assert!(
+        (major / minor).sqrt() > 1.8,
+        "off should be anisotropic: {}",
+        report(off)
+    );
 }
 
 /// A chart covering the UV square [0.25, 0.75]², gutter around it; `f(x, y)`

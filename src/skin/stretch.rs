@@ -167,7 +167,11 @@ impl StretchTensor {
         let [e, f, _] = metric(a, b);
         let k = if e > 1e-12 { f / e } else { 0.0 };
         let v = 1.0 / (b - k * a).length().max(1e-6);
-        Self { u, v, shear: -k * v }
+        Self {
+            u,
+            v,
+            shear: -k * v,
+        }
     }
 
     /// The two passes' steps, in texels (u, v) per mm of surface: the U pass's
@@ -210,7 +214,11 @@ mod tests {
         let (cos, sin) = (0.6f32, 0.8f32);
         let tilt = |p: Vec3| Vec3::new(p.x, p.y * 0.6, p.y * 0.8);
         let at = |u: f32, v: f32| tilt(Vec3::new(0.05 * u + 0.08 * cos * v, 0.08 * sin * v, 0.0));
-        let uv = [Vec2::new(10.0, 20.0), Vec2::new(40.0, 25.0), Vec2::new(15.0, 60.0)];
+        let uv = [
+            Vec2::new(10.0, 20.0),
+            Vec2::new(40.0, 25.0),
+            Vec2::new(15.0, 60.0),
+        ];
         jacobian(uv.map(|t| at(t.x, t.y)), uv)
     }
 
@@ -244,15 +252,24 @@ mod tests {
         };
         let on = StretchTensor::of(a, b, true);
         let (major, minor, cross) = surface_covariance(on);
-        println!("on: eigen-variances {major:.6} {minor:.6} (σ = 1 mm), steps {:?}", on.steps());
+        println!(
+            "on: eigen-variances {major:.6} {minor:.6} (σ = 1 mm), steps {:?}",
+            on.steps()
+        );
         assert!((major - 1.0).abs() < 1e-5 && (minor - 1.0).abs() < 1e-5);
-        assert!(cross.abs() < 1e-5, "the passes are orthogonal on the surface: {cross}");
+        assert!(
+            cross.abs() < 1e-5,
+            "the passes are orthogonal on the surface: {cross}"
+        );
         // M⁻¹ = U·Uᵀ.
         let [e, f, g] = metric(a, b);
         let det = e * g - f * f;
         let want = [g / det, -f / det, e / det];
         for (got, want) in on.inverse_metric().iter().zip(want) {
-            assert!((got - want).abs() < 1e-4 * want.abs().max(1.0), "{got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-4 * want.abs().max(1.0),
+                "{got} vs {want}"
+            );
         }
         // The diagonal alone: 1 ± cos along the bisectors.
         let (major, minor, _) = surface_covariance(StretchTensor::of(a, b, false));
@@ -299,9 +316,7 @@ mod tests {
                 v.push((st.v, area));
                 shear.push((st.shear.abs(), area));
             }
-            let range = |x: &mut Vec<(f32, f64)>| {
-                [0.001, 0.5, 0.999].map(|q| percentile(x, q))
-            };
+            let range = |x: &mut Vec<(f32, f64)>| [0.001, 0.5, 0.999].map(|q| percentile(x, q));
             let (ru, rv, rs) = (range(&mut u), range(&mut v), range(&mut shear));
             println!(
                 "scan at {side}²: |cos(u, v)| median {:.2}, 90th percentile {:.2}; texels/mm \
