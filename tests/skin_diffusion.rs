@@ -64,7 +64,7 @@ fn chain_with(
         let pipelines = Pipelines::new(ctx);
         let stretch = StretchMaps::new(&pipelines, N, &profile, constant, true).unwrap();
         let sampler = Arc::new(Sampler::clamped(ctx, true).unwrap());
-        let blur = BlurChain::new(&pipelines, kernel, sampler).unwrap();
+        let blur = BlurChain::new(&pipelines, kernel, sampler, true).unwrap();
         let plan = chain::plan(&profile, variant, N, mean_stretch(mesh, N));
         let readbacks: Vec<Readback> = plan
             .iter()
@@ -268,7 +268,7 @@ fn one_gaussian(mesh: &Mesh, input: &[[f32; 4]], sigma_mm: f32, shear: bool) -> 
         let pipelines = Pipelines::new(ctx);
         let stretch = StretchMaps::new(&pipelines, N, &Profile::skin(), None, shear).unwrap();
         let sampler = Arc::new(Sampler::clamped(ctx, true).unwrap());
-        let blur = BlurChain::new(&pipelines, &accurate(), sampler).unwrap();
+        let blur = BlurChain::new(&pipelines, &accurate(), sampler, shear).unwrap();
         let readback = Readback::new(ctx, "blurred", (N * N * 8) as u64).unwrap();
         let mut g = Graph::new();
         let input = g.import_image(
@@ -292,6 +292,12 @@ fn one_gaussian(mesh: &Mesh, input: &[[f32; 4]], sigma_mm: f32, shear: bool) -> 
 /// each texel's UV offset mapped by `jacobian`. Returns the covariance's two
 /// eigenvalues (major, minor) and its cross term.
 fn surface_moments(values: &[f32], jacobian: [Vec2; 2]) -> (f64, f64, f64) {
+    surface_moments_less(values, jacobian, 0.0)
+}
+
+/// [`surface_moments`] less an isotropic UV-space variance of `uv_variance`
+/// texels² (bilinear upsampling's tent), mapped to the surface.
+fn surface_moments_less(values: &[f32], jacobian: [Vec2; 2], uv_variance: f64) -> (f64, f64, f64) {
     let (mut w, mut xx, mut xy, mut yy) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for (i, &v) in values.iter().enumerate() {
         let du = (i as u32 % N) as f32 - (N / 2) as f32;
@@ -303,7 +309,10 @@ fn surface_moments(values: &[f32], jacobian: [Vec2; 2]) -> (f64, f64, f64) {
         xy += v * (p.x * p.y) as f64;
         yy += v * (p.y * p.y) as f64;
     }
-    let (xx, xy, yy) = (xx / w, xy / w, yy / w);
+    let (a, b) = (jacobian[0].as_dvec2(), jacobian[1].as_dvec2());
+    let xx = xx / w - uv_variance * (a.x * a.x + b.x * b.x);
+    let xy = xy / w - uv_variance * (a.x * a.y + b.x * b.y);
+    let yy = yy / w - uv_variance * (a.y * a.y + b.y * b.y);
     let mean = 0.5 * (xx + yy);
     let d = (0.25 * (xx - yy).powi(2) + xy * xy).sqrt();
     (mean + d, mean - d, xy)
@@ -353,6 +362,51 @@ fn shear_correction_makes_sheared_uvs_isotropic() {
         "off should be anisotropic: {}",
         report(off)
     );
+}
+
+#[test]
+fn shear_correction_holds_down_the_adaptive_chain() {
+    // The same sheared plane through the adaptive chain, whose levels shrink
+    // (512² to 128² at level 2 here) as the V passes step along the sheared
+    // direction: each level's surface covariance is its total variance v_k,
+    // isotropic, once the bilinear upsampling to N² (a tent of (N/side)²/6
+    // texels² along u and v) is taken off — as close as on an unsheared plane
+    // (cos 0), where the adaptive chain's own coarseness is all there is.
+    let profile = Profile::skin();
+    let mut worst = [0.0f64; 2];
+    for (i, cos) in [0.0, 0.6].into_iter().enumerate() {
+        let (mesh, jacobian) = sheared_plane(24.0, cos);
+        let plan = chain::plan(&profile, Chain::Adaptive, N, mean_stretch(&mesh, N));
+        let levels = chain_with(&mesh, &impulse(100.0), &accurate(), true, Chain::Adaptive);
+        // Level 1 (σ 1.9 texels) is the impulse itself; level 6's 3σ (8.2 mm)
+        // meets the chart's border (9.6 mm away).
+        for k in 1..5 {
+            let green: Vec<f32> = levels[k].iter().map(|c| c.y).collect();
+            let f = (N / plan[k].resolution) as f64;
+            let (major, minor, cross) = surface_moments_less(&green, jacobian, f * f / 6.0);
+            let v = profile.gaussians[k].variance_mm2 as f64;
+            println!(
+                "cos {cos}: adaptive level {} at {}²: eigen-variances {:.4} / {:.4} v, cross {:+.4} v",
+                k + 1,
+                plan[k].resolution,
+                major / v,
+                minor / v,
+                cross / v
+            );
+            let error = [
+                (major / v - 1.0).abs(),
+                (minor / v - 1.0).abs(),
+                (cross / v).abs(),
+            ];
+            worst[i] = error.into_iter().fold(worst[i], f64::max);
+        }
+    }
+    println!(
+        "worst relative error: unsheared {:.4}, sheared {:.4}",
+        worst[0], worst[1]
+    );
+    assert!(worst[1] < worst[0] + 0.03, "{worst:?}");
+    assert!(worst[1] < 0.08, "{worst:?}");
 }
 
 /// A chart covering the UV square [0.25, 0.75]², gutter around it; `f(x, y)`

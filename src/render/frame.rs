@@ -209,7 +209,7 @@ impl Passes {
                 skin.shear_correction,
             )?,
             irradiance: IrradiancePass::new(p, variant)?,
-            blur: BlurChain::new(p, &skin.kernel, s.linear.clone())?,
+            blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(p, variant)?,
             shadow: ShadowPass::new(p, &lighting.views, lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,
