@@ -1,7 +1,8 @@
 #version 460
 // One direction of one Gaussian of the skin chain (GPU Gems 3 §14.4.2-3): the
 // destination texel's taps sit at offset_σ · σ_mm · stretch along the blur axis,
-// stretch (texels/mm) read from the stretch level before this one, and are read
+// stretch (texels/mm) read from the stretch level before this one (the V pass:
+// along the surface perpendicular of ∂P/∂u where the UVs are sheared), and are read
 // with bilinear filtering in normalised coordinates, so the source may be finer
 // than the destination (the adaptive chain downsamples as it blurs; the Gaussian
 // is the low-pass). The same shader blurs the stretch chain (src = stretch).
@@ -39,13 +40,23 @@ void main() {
                          : src_size / vec2(size);
     bool along_u = pc.dir.x != 0;
     float sigma_texels = pc.sigma_mm * (along_u ? s.x : s.y);
+    // One source texel along the blur axis, in normalised coordinates.
+    vec2 texel = vec2(pc.dir) / src_size;
+    // Shear (stretch.frag): the V pass steps along the surface direction
+    // perpendicular to ∂P/∂u, (st.b, st.g) texels per mm, so the two passes are
+    // orthogonal on the surface. st.b = 0 (no shear, or shear correction off):
+    // the plain V axis, as before.
+    if (!along_u && st.a > 1e-4 && st.b != 0.0) {
+        vec2 step = vec2(st.b / st.a * src_size.x / float(textureSize(stretch, 0).x), s.y);
+        float len = length(step);
+        sigma_texels = pc.sigma_mm * len;
+        texel = step / (len * src_size);
+    }
     // σ = 0 (skin.blur_width = 0 on the stretch chain): a copy.
     if (sigma_texels <= 0.0) {
         imageStore(dst, p, textureLod(src, uv, 0.0));
         return;
     }
-    // One source texel along the blur axis, in normalised coordinates.
-    vec2 texel = vec2(pc.dir) / src_size;
     vec4 sum = vec4(0.0);
     if (TAP_COUNT > 0) {
         for (int i = 0; i < TAP_COUNT; ++i) {

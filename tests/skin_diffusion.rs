@@ -62,9 +62,9 @@ fn chain_with(
         let profile = Profile::skin();
         let constant = (!correction).then(|| mean_stretch(mesh, N));
         let pipelines = Pipelines::new(ctx);
-        let stretch = StretchMaps::new(&pipelines, N, &profile, constant).unwrap();
+        let stretch = StretchMaps::new(&pipelines, N, &profile, constant, true).unwrap();
         let sampler = Arc::new(Sampler::clamped(ctx, true).unwrap());
-        let blur = BlurChain::new(&pipelines, kernel, sampler).unwrap();
+        let blur = BlurChain::new(&pipelines, kernel, sampler, true).unwrap();
         let plan = chain::plan(&profile, variant, N, mean_stretch(mesh, N));
         let readbacks: Vec<Readback> = plan
             .iter()
@@ -232,6 +232,181 @@ fn stretch_correction_makes_stretched_uvs_isotropic() {
     let ratio = |w: Vec2| w.y / w.x;
     assert!((ratio(on) - 1.0).abs() < 0.05, "on: {on}");
     assert!(ratio(off) > 1.3, "off should be anisotropic: {off}");
+}
+
+/// A plane whose UVs are an affine shear of its positions: u runs along x and v
+/// along (cos φ, sin φ), each `l` mm across the UV square, so the surface
+/// directions of u and v meet at φ (cos φ = `cos`). Returns the mesh and the
+/// map from UV texels to surface mm, as the two columns ∂P/∂u, ∂P/∂v.
+fn sheared_plane(l: f32, cos: f32) -> (Mesh, [Vec2; 2]) {
+    let sin = (1.0 - cos * cos).sqrt();
+    let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let at = |u: f32, v: f32| Vec3::new(l * (u + cos * v), l * sin * v, 0.0);
+    let mesh = Mesh {
+        name: "sheared plane".into(),
+        positions: corners.iter().map(|&(u, v)| at(u, v)).collect(),
+        normals: vec![Vec3::Z; 4],
+        uvs: corners.iter().map(|&(u, v)| Vec2::new(u, v)).collect(),
+        tangents: vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    let texel = l / N as f32;
+    (
+        mesh,
+        [Vec2::new(texel, 0.0), Vec2::new(texel * cos, texel * sin)],
+    )
+}
+
+/// One Gaussian of σ mm (the accurate kernel, taps spaced by the unblurred
+/// stretch map) on `input`; the N² result divided by its coverage.
+fn one_gaussian(mesh: &Mesh, input: &[[f32; 4]], sigma_mm: f32, shear: bool) -> Vec<Vec3> {
+    common::with_gpu(|ctx: &Arc<Context>| {
+        let texels: Vec<f32> = input.iter().flatten().copied().collect();
+        let bytes = common::to_f16_bytes(&texels);
+        let irr = upload_texture(ctx, "input", ImageDesc::new(N, N, UV_FORMAT), &bytes).unwrap();
+        let buffers = Arc::new(MeshBuffers::upload(ctx, mesh).unwrap());
+        let pipelines = Pipelines::new(ctx);
+        let stretch = StretchMaps::new(&pipelines, N, &Profile::skin(), None, shear).unwrap();
+        let sampler = Arc::new(Sampler::clamped(ctx, true).unwrap());
+        let blur = BlurChain::new(&pipelines, &accurate(), sampler, shear).unwrap();
+        let readback = Readback::new(ctx, "blurred", (N * N * 8) as u64).unwrap();
+        let mut g = Graph::new();
+        let input = g.import_image(
+            "input",
+            Imported::Image(irr.clone()),
+            Some(Access::ShaderSampled),
+            None,
+        );
+        let st = stretch.pass(&mut g, &buffers, &blur);
+        let mut dst = g.create_image("blurred", ImageDesc::new(N, N, UV_FORMAT));
+        blur.gaussian(&mut g, "blurred", &input, &st[0], sigma_mm, &mut dst);
+        readback.image_pass(&mut g, &dst);
+        let mut ex = Executor::new(ctx, 1).unwrap();
+        ex.run(g).unwrap();
+        ex.finish().unwrap();
+        bilinear(&common::from_f16_bytes(readback.bytes().unwrap()), N)
+    })
+}
+
+/// Second moments (mm²) of `values` on the surface, about the centre texel:
+/// each texel's UV offset mapped by `jacobian`. Returns the covariance's two
+/// eigenvalues (major, minor) and its cross term.
+fn surface_moments(values: &[f32], jacobian: [Vec2; 2]) -> (f64, f64, f64) {
+    surface_moments_less(values, jacobian, 0.0)
+}
+
+/// [`surface_moments`] less an isotropic UV-space variance of `uv_variance`
+/// texels² (bilinear upsampling's tent), mapped to the surface.
+fn surface_moments_less(values: &[f32], jacobian: [Vec2; 2], uv_variance: f64) -> (f64, f64, f64) {
+    let (mut w, mut xx, mut xy, mut yy) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (i, &v) in values.iter().enumerate() {
+        let du = (i as u32 % N) as f32 - (N / 2) as f32;
+        let dv = (i as u32 / N) as f32 - (N / 2) as f32;
+        let p = jacobian[0] * du + jacobian[1] * dv;
+        let v = v as f64;
+        w += v;
+        xx += v * (p.x * p.x) as f64;
+        xy += v * (p.x * p.y) as f64;
+        yy += v * (p.y * p.y) as f64;
+    }
+    let (a, b) = (jacobian[0].as_dvec2(), jacobian[1].as_dvec2());
+    let xx = xx / w - uv_variance * (a.x * a.x + b.x * b.x);
+    let xy = xy / w - uv_variance * (a.x * a.y + b.x * b.y);
+    let yy = yy / w - uv_variance * (a.y * a.y + b.y * b.y);
+    let mean = 0.5 * (xx + yy);
+    let d = (0.25 * (xx - yy).powi(2) + xy * xy).sqrt();
+    (mean + d, mean - d, xy)
+}
+
+#[test]
+fn shear_correction_makes_sheared_uvs_isotropic() {
+    // u along x, v at 53° to it on the surface (cos 0.6): 24 mm across the UV
+    // square, 0.047 mm per texel along each axis. σ = 0.6 mm is 12.8 texels
+    // along u; the chart's nearest border is 9.6 mm (16σ) from the impulse.
+    let cos = 0.6;
+    let (mesh, jacobian) = sheared_plane(24.0, cos);
+    let sigma = 0.6f32;
+    let variance = (sigma * sigma) as f64;
+    let green = |out: Vec<Vec3>| out.iter().map(|c| c.y).collect::<Vec<f32>>();
+    let on = surface_moments(
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, true)),
+        jacobian,
+    );
+    let off = surface_moments(
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, false)),
+        jacobian,
+    );
+    let report = |(major, minor, cross): (f64, f64, f64)| {
+        format!(
+            "eigen-variances {:.4} / {:.4} σ², cross {:+.4} σ², width ratio {:.3}",
+            major / variance,
+            minor / variance,
+            cross / variance,
+            (major / minor).sqrt()
+        )
+    };
+    println!(
+        "sheared UVs (cos {cos}), one Gaussian of σ = {sigma} mm, surface moments: \
+         shear correction on: {}; off: {}",
+        report(on),
+        report(off)
+    );
+    let (major, minor, cross) = on;
+    assert!((major / variance - 1.0).abs() < 0.03, "on: {}", report(on));
+    assert!((minor / variance - 1.0).abs() < 0.03, "on: {}", report(on));
+    assert!((cross / variance).abs() < 0.02, "on: {}", report(on));
+    // Off: the u-then-v blur makes σ²(â âᵀ + b̂ b̂ᵀ), eigen-variances σ²(1 ± cos).
+    let (major, minor, _) = off;
+    assert!(
+        (major / minor).sqrt() > 1.8,
+        "off should be anisotropic: {}",
+        report(off)
+    );
+}
+
+#[test]
+fn shear_correction_holds_down_the_adaptive_chain() {
+    // The same sheared plane through the adaptive chain, whose levels shrink
+    // (512² to 128² at level 2 here) as the V passes step along the sheared
+    // direction: each level's surface covariance is its total variance v_k,
+    // isotropic, once the bilinear upsampling to N² (a tent of (N/side)²/6
+    // texels² along u and v) is taken off — as close as on an unsheared plane
+    // (cos 0), where the adaptive chain's own coarseness is all there is.
+    let profile = Profile::skin();
+    let mut worst = [0.0f64; 2];
+    for (i, cos) in [0.0, 0.6].into_iter().enumerate() {
+        let (mesh, jacobian) = sheared_plane(24.0, cos);
+        let plan = chain::plan(&profile, Chain::Adaptive, N, mean_stretch(&mesh, N));
+        let levels = chain_with(&mesh, &impulse(100.0), &accurate(), true, Chain::Adaptive);
+        // Level 1 (σ 1.9 texels) is the impulse itself; level 6's 3σ (8.2 mm)
+        // meets the chart's border (9.6 mm away).
+        for k in 1..5 {
+            let green: Vec<f32> = levels[k].iter().map(|c| c.y).collect();
+            let f = (N / plan[k].resolution) as f64;
+            let (major, minor, cross) = surface_moments_less(&green, jacobian, f * f / 6.0);
+            let v = profile.gaussians[k].variance_mm2 as f64;
+            println!(
+                "cos {cos}: adaptive level {} at {}²: eigen-variances {:.4} / {:.4} v, cross {:+.4} v",
+                k + 1,
+                plan[k].resolution,
+                major / v,
+                minor / v,
+                cross / v
+            );
+            let error = [
+                (major / v - 1.0).abs(),
+                (minor / v - 1.0).abs(),
+                (cross / v).abs(),
+            ];
+            worst[i] = error.into_iter().fold(worst[i], f64::max);
+        }
+    }
+    println!(
+        "worst relative error: unsheared {:.4}, sheared {:.4}",
+        worst[0], worst[1]
+    );
+    assert!(worst[1] < worst[0] + 0.03, "{worst:?}");
+    assert!(worst[1] < 0.08, "{worst:?}");
 }
 
 /// A chart covering the UV square [0.25, 0.75]², gutter around it; `f(x, y)`

@@ -202,9 +202,15 @@ impl Passes {
         let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
         Ok(Self {
             direct: DirectPass::new(p, variant)?,
-            stretch: StretchMaps::new(p, res, &skin.profile, constant_stretch)?,
+            stretch: StretchMaps::new(
+                p,
+                res,
+                &skin.profile,
+                constant_stretch,
+                skin.shear_correction,
+            )?,
             irradiance: IrradiancePass::new(p, variant)?,
-            blur: BlurChain::new(p, &skin.kernel, s.linear.clone())?,
+            blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(p, variant, skin.transmission > 0.0)?,
             shadow: ShadowPass::new(p, &lighting.views, lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,

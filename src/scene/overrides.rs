@@ -154,6 +154,10 @@ overrides! {
     /// from shadowed lights behind it; 0: off. Replaces `skin.transmission`.
     #[arg(allow_hyphen_values = true)]
     transmission: f32 => skin.transmission, example "0.5";
+    /// Blur along the surface metric of the UVs, shear included (off: along u
+    /// and v, their scale only), replacing `skin.shear_correction`.
+    #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
+    shear_correction: bool => skin.shear_correction, example "off";
     /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     test_texture: bool => textures.test_texture, example "on";

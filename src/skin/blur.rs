@@ -42,10 +42,19 @@ pub struct BlurChain {
     pipeline: Arc<Pipeline>,
     taps: Arc<Buffer>,
     sampler: Arc<Sampler>,
+    /// The stretch maps hold the shear (skin.shear_correction): the V pass
+    /// may step across columns, so the U pass keeps the source's width.
+    shear: bool,
 }
 
 impl BlurChain {
-    pub fn new(pipelines: &Pipelines, kernel: &BlurKernel, sampler: Arc<Sampler>) -> Result<Self> {
+    /// `shear`: the stretch maps hold the UV shear (skin::stretch, `shear`).
+    pub fn new(
+        pipelines: &Pipelines,
+        kernel: &BlurKernel,
+        sampler: Arc<Sampler>,
+        shear: bool,
+    ) -> Result<Self> {
         let ctx = pipelines.ctx();
         // std140: one vec4 (offset in σ, weight, 0, 0) per tap.
         let mut taps = [[0.0f32; 4]; MAX_FIXED_TAPS];
@@ -73,6 +82,7 @@ impl BlurChain {
                 Access::UniformRead,
             )?,
             sampler,
+            shear,
         })
     }
 
@@ -129,6 +139,11 @@ impl BlurChain {
 
     /// One Gaussian of σ mm, separably, from `src` into `dst` (whose side may be
     /// smaller): `{name}_u` writes dst's width × src's height, `{name}_v` dst.
+    /// With shear the V pass's taps leave their column, and linear
+    /// interpolation across a narrowed intermediate's columns would widen the
+    /// blur along u by 1/6 of its texel² (13 % of a level's variance at 4×
+    /// narrower, tests/skin_diffusion.rs): `{name}_u` then keeps src's width
+    /// and `{name}_v` alone shrinks it.
     pub fn gaussian(
         &self,
         g: &mut Graph,
@@ -138,7 +153,12 @@ impl BlurChain {
         sigma_mm: f32,
         dst: &mut ImageHandle,
     ) {
-        let tmp_desc = ImageDesc::new(dst.desc.width, src.desc.height, UV_FORMAT);
+        let width = if self.shear {
+            src.desc.width
+        } else {
+            dst.desc.width
+        };
+        let tmp_desc = ImageDesc::new(width, src.desc.height, UV_FORMAT);
         let mut tmp = g.create_image(&format!("{name}_tmp"), tmp_desc);
         let along = |dir| BlurPush { dir, sigma_mm };
         let u = format!("{name}_u");

@@ -58,6 +58,10 @@ pub struct SkinSettings {
     /// the term). The profile's weights and variances give its transmittance
     /// ([`profile::Profile::transmittance`]).
     pub transmission: f32,
+    /// Store the UV shear in the stretch maps and blur along the surface
+    /// perpendicular of ∂P/∂u (skin::stretch::StretchTensor); off: the diagonal
+    /// only, u then v.
+    pub shear_correction: bool,
 }
 
 impl SkinSettings {
@@ -110,6 +114,7 @@ impl SkinSettings {
             resolution: render.irradiance_resolution,
             stretch_correction: skin.stretch_correction,
             transmission: skin.transmission,
+            shear_correction: skin.shear_correction,
         })
     }
 }

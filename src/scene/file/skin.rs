@@ -80,6 +80,11 @@ pub struct Skin {
     /// Correct blur widths for UV distortion with the stretch map (the paper's
     /// section II.B); off: one texels-per-mm constant for the whole mesh.
     pub stretch_correction: bool,
+    /// Blur along the surface metric of the UVs, not only their scale: the V
+    /// pass steps along the surface perpendicular of ∂P/∂u (docs/skin.md,
+    /// "Shear-aware diffusion"); off: along v, as if the UV axes met at right
+    /// angles on the surface.
+    pub shear_correction: bool,
     /// Scale on every variance of the profile (the paper's "blurring width";
     /// 0: no blur).
     pub blur_width: f32,
@@ -102,6 +107,7 @@ impl Default for Skin {
             regions: None,
             occlusion: Occlusion::Raytrace,
             stretch_correction: true,
+            shear_correction: true,
             blur_width: 1.0,
             blur_amount: 1.0,
             transmission: 1.0,
