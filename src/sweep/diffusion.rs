@@ -187,12 +187,17 @@ pub fn run(
                 .iter()
                 .zip(values)
                 .map(|(p, v)| {
-                    let extra = plus.get(4 * p.index..4 * p.index + 3).map_or(Vec3::ZERO, Vec3::from_slice);
+                    let extra = plus
+                        .get(4 * p.index..4 * p.index + 3)
+                        .map_or(Vec3::ZERO, Vec3::from_slice);
                     p.shade * *v + extra
                 })
                 .collect()
         };
-        let (want_px, got_px) = (shaded(&reference.pixel_diffused, &[]), shaded(&pixel_diffused, &transmitted));
+        let (want_px, got_px) = (
+            shaded(&reference.pixel_diffused, &[]),
+            shaded(&pixel_diffused, &transmitted),
+        );
         let screen = |values: &[Vec3]| {
             let mut out = vec![0.0f32; 4 * (w * h) as usize];
             for (p, v) in reference.pixels.iter().zip(values) {
@@ -395,12 +400,33 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
     let ids = region_ids(scene, &texels);
     let pixel_ids = region_ids(
         scene,
-        &pixels.iter().map(|p| Texel { x: 0, y: 0, uv: p.uv, position: p.position, normal: Vec3::ZERO }).collect::<Vec<_>>(),
+        &pixels
+            .iter()
+            .map(|p| Texel {
+                x: 0,
+                y: 0,
+                uv: p.uv,
+                position: p.position,
+                normal: Vec3::ZERO,
+            })
+            .collect::<Vec<_>>(),
     );
-    let ears = REGION_NAMES.iter().position(|n| *n == "ears").expect("a region");
+    let ears = REGION_NAMES
+        .iter()
+        .position(|n| *n == "ears")
+        .expect("a region");
     let pixel_masks = vec![
-        ("face".to_string(), pixel_ids.iter().map(|&i| i != REGION_NAMES.len() - 1).collect()),
-        ("ears".to_string(), pixel_ids.iter().map(|&i| i == ears).collect()),
+        (
+            "face".to_string(),
+            pixel_ids
+                .iter()
+                .map(|&i| i != REGION_NAMES.len() - 1)
+                .collect(),
+        ),
+        (
+            "ears".to_string(),
+            pixel_ids.iter().map(|&i| i == ears).collect(),
+        ),
         ("all".to_string(), vec![true; pixels.len()]),
     ];
     let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
