@@ -65,16 +65,62 @@ pub struct DiffusionRow {
 #[derive(Clone, Debug, Serialize)]
 pub struct RegionRow {
     pub region: String,
+    /// Against the reference with every path (skin::reference::Scattered).
     pub error: RelativeError,
+    /// Against the reference without the paths through the air.
+    pub error_inside: RelativeError,
+    /// Share of texels whose luminance lies between the two references (± 1 %).
+    pub bracketed: f64,
     /// Σ(chain − reference)/Σ reference per channel: the colour's bias.
     pub bias_rgb: [f64; 3],
+}
+
+/// Share by which a value may stand outside the references' bracket and count
+/// as within it.
+const BRACKET_SLACK: f32 = 0.01;
+
+impl RegionRow {
+    /// The chain's values `got` against the references `upper` (every path) and
+    /// `lower` (none through the air) over `mask`.
+    fn new(
+        region: String,
+        upper: &[Vec3],
+        lower: &[Vec3],
+        got: &[Vec3],
+        mask: &[bool],
+    ) -> Result<Self> {
+        let rgba =
+            |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|c| c.extend(1.0).to_array()).collect() };
+        let got_rgba = rgba(got);
+        let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let inside = upper
+            .iter()
+            .zip(lower)
+            .zip(got)
+            .zip(mask)
+            .filter(|(_, &m)| m)
+            .filter(|(((u, l), g), _)| {
+                let (u, l, g) = (lum(**u), lum(**l), lum(**g));
+                g >= l * (1.0 - BRACKET_SLACK) && g <= u * (1.0 + BRACKET_SLACK)
+            })
+            .count();
+        Ok(RegionRow {
+            error: relative(&rgba(upper), &got_rgba, mask)?,
+            error_inside: relative(&rgba(lower), &got_rgba, mask)?,
+            bracketed: inside as f64 / mask.iter().filter(|&&m| m).count().max(1) as f64,
+            bias_rgb: bias(upper, got, mask),
+            region,
+        })
+    }
 }
 
 /// The reference at every texel, and what the comparison needs of the mesh.
 struct Reference {
     texels: Vec<Texel>,
     irradiance: Vec<Vec3>,
+    /// With every path, and without those through the air.
     diffused: Vec<Vec3>,
+    inside: Vec<Vec3>,
     masks: Vec<(String, Vec<bool>)>,
     /// Each texel's face region.
     region: Vec<usize>,
@@ -82,6 +128,7 @@ struct Reference {
     /// there.
     pixels: Vec<Pixel>,
     pixel_diffused: Vec<Vec3>,
+    pixel_inside: Vec<Vec3>,
     /// The face, the ears and every pixel.
     pixel_masks: Vec<(String, Vec<bool>)>,
     seconds: f64,
@@ -92,6 +139,7 @@ struct Pixel {
     index: usize,
     uv: Vec2,
     position: Vec3,
+    normal: Vec3,
     /// albedo^(1−mix)/π: what the final pass multiplies the diffused irradiance by.
     shade: Vec3,
 }
@@ -162,19 +210,18 @@ pub fn run(
             })
             .collect();
         let name = format!("{chain:?}").to_lowercase();
-        let rgba =
-            |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|c| c.extend(1.0).to_array()).collect() };
-        let (want, got) = (rgba(&reference.diffused), rgba(&diffused));
         let mut regions = reference
             .masks
             .iter()
             .filter(|(_, mask)| mask.contains(&true))
             .map(|(region, mask)| {
-                Ok(RegionRow {
-                    region: region.clone(),
-                    error: relative(&want, &got, mask)?,
-                    bias_rgb: bias(&reference.diffused, &diffused, mask),
-                })
+                RegionRow::new(
+                    region.clone(),
+                    &reference.diffused,
+                    &reference.inside,
+                    &diffused,
+                    mask,
+                )
             })
             .collect::<Result<Vec<_>>>()?;
         // The diffuse term through the camera, shaded as the final pass, the
@@ -194,8 +241,9 @@ pub fn run(
                 })
                 .collect()
         };
-        let (want_px, got_px) = (
+        let (want_px, inside_px, got_px) = (
             shaded(&reference.pixel_diffused, &[]),
+            shaded(&reference.pixel_inside, &[]),
             shaded(&pixel_diffused, &transmitted),
         );
         let screen = |values: &[Vec3]| {
@@ -208,15 +256,8 @@ pub fn run(
         let (screen_want, screen_got) = (screen(&want_px), screen(&got_px));
         for (label, mask) in &reference.pixel_masks {
             if mask.contains(&true) {
-                let mut image_mask = vec![false; (w * h) as usize];
-                for (p, &m) in reference.pixels.iter().zip(mask) {
-                    image_mask[p.index] = m;
-                }
-                regions.push(RegionRow {
-                    region: format!("screen {w}×{h}: {label}"),
-                    error: relative(&screen_want, &screen_got, &image_mask)?,
-                    bias_rgb: bias(&want_px, &got_px, mask),
-                });
+                let label = format!("screen {w}×{h}: {label}");
+                regions.push(RegionRow::new(label, &want_px, &inside_px, &got_px, mask)?);
             }
         }
         if let Some(dir) = &opts.out_dir {
@@ -378,23 +419,31 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
     let task = Task::new("exact diffusion", (texels.len() + pixels.len()) as u64);
     let start = Instant::now();
     let lookup = |uv: Vec2| irradiance.at(uv);
-    let exact = |position: Vec3, e: Vec3| {
-        let s = diffusion.at(position, &lookup);
+    // (every path, none through the air)
+    let exact = |position: Vec3, normal: Vec3, e: Vec3| {
+        let s = diffusion.at(position, normal, &lookup);
         let open = edges.to_open(position);
         let reach = diffusion.reach();
-        let d = s.diffuse(&weights, |k| open.is_some_and(|o| o < reach[k]));
+        let normalised = |k: usize| open.is_some_and(|o| o < reach[k]);
         task.add(1);
-        e.lerp(d, skin.blur_amount)
+        let d = |air| e.lerp(s.diffuse(&weights, air, normalised), skin.blur_amount);
+        (d(true), d(false))
     };
-    let diffused: Vec<Vec3> = texels
+    let (diffused, inside): (Vec<Vec3>, Vec<Vec3>) = texels
         .par_iter()
         .zip(&e)
-        .map(|(t, &e)| exact(t.position, e))
-        .collect();
-    let pixel_diffused: Vec<Vec3> = pixels
+        .map(|(t, &e)| exact(t.position, t.normal, e))
+        .unzip();
+    let (pixel_diffused, pixel_inside): (Vec<Vec3>, Vec<Vec3>) = pixels
         .par_iter()
-        .map(|p| exact(p.position, irradiance.at(p.uv).unwrap_or(Vec3::ZERO)))
-        .collect();
+        .map(|p| {
+            exact(
+                p.position,
+                p.normal,
+                irradiance.at(p.uv).unwrap_or(Vec3::ZERO),
+            )
+        })
+        .unzip();
     let seconds = start.elapsed().as_secs_f64();
     drop(task);
     let ids = region_ids(scene, &texels);
@@ -463,6 +512,8 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         pixel_masks,
         pixels,
         pixel_diffused,
+        pixel_inside,
+        inside,
         seconds,
     })
 }
@@ -490,11 +541,13 @@ fn pixels(scene: &Scene, skin: &SkinSettings) -> Vec<Pixel> {
             let b = hit.barycentric.to_array();
             let uv: Vec2 = (0..3).map(|c| b[c] * mesh.uvs[corner(c)]).sum();
             let position: Vec3 = (0..3).map(|c| b[c] * mesh.positions[corner(c)]).sum();
+            let normal: Vec3 = (0..3).map(|c| b[c] * mesh.normals[corner(c)]).sum();
             let albedo = rgba8(&scene.albedo, uv).truncate();
             Some(Pixel {
                 index: i as usize,
                 uv,
                 position,
+                normal: normal.normalize_or_zero(),
                 shade: albedo.powf(1.0 - skin.mix) / std::f32::consts::PI,
             })
         })
@@ -625,13 +678,13 @@ fn bias(want: &[Vec3], got: &[Vec3], mask: &[bool]) -> [f64; 3] {
 pub fn table(rows: &[DiffusionRow]) -> String {
     let pct = |v: f64| format!("{:.1} %", 100.0 * v);
     let mut out = String::from(
-        "| environment | chain | region | texels | mean | median | p90 | bias R | bias G | bias B |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| environment | chain | region | texels | mean | median | p90 | bias R | bias G | bias B | mean, no air paths | in bracket |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         for g in &r.regions {
             out += &format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
                 r.environment,
                 r.chain,
                 g.region,
@@ -642,6 +695,8 @@ pub fn table(rows: &[DiffusionRow]) -> String {
                 pct(g.bias_rgb[0]),
                 pct(g.bias_rgb[1]),
                 pct(g.bias_rgb[2]),
+                pct(g.error_inside.mean),
+                pct(g.bracketed),
             );
         }
     }

@@ -40,6 +40,11 @@ pub const EXTENT_SIGMA: f32 = 4.0;
 pub const FINEST_SIGMA: f32 = 0.05;
 /// See [`FINEST_SIGMA`].
 pub const SMOOTH_E: f32 = 0.02;
+/// A path that rises more than this above x's tangent plane leaves x into the
+/// air (see [`Scattered::through_air`]): steeper than a gently curved surface's
+/// own chords (at 5 mm on a 20 mm radius of curvature, 7°), shallower than a
+/// fold's other side.
+pub const AIR_ELEVATION_DEG: f32 = 20.0;
 /// Splits per triangle at most (a guard against degenerate input).
 const MAX_DEPTH: u32 = 24;
 
@@ -62,6 +67,12 @@ pub struct Scattered {
     pub irradiance: Vec<Vec3>,
     /// C_k: Gaussian k integrated over the surface (1 on a plane).
     pub reach: Vec<f32>,
+    /// The part of M_k whose straight path leaves x into the air: more than
+    /// [`AIR_ELEVATION_DEG`] above x's tangent plane (across a fold, a crease,
+    /// the gap behind an ear), where light inside the skin goes the longer way
+    /// round. Without it, M_k is a lower bound of the light there; with it an
+    /// upper bound (docs/skin.md, "Exact diffusion").
+    pub through_air: Vec<Vec3>,
 }
 
 impl<'a> Diffusion<'a> {
@@ -139,22 +150,30 @@ impl<'a> Diffusion<'a> {
         *self.reach.last().expect("checked non-empty")
     }
 
-    /// M_k and C_k at `x` (mm). `irradiance(uv)` is E at a point of the mesh by
-    /// its UV; `None` where there is none (outside the irradiance's coverage):
-    /// such a piece counts in neither.
-    pub fn at(&self, x: Vec3, irradiance: &impl Fn(Vec2) -> Option<Vec3>) -> Scattered {
+    /// M_k and C_k at `x` (mm), whose outward normal is `normal` (zero: no path
+    /// counts as through the air). `irradiance(uv)` is E at a point of the mesh
+    /// by its UV; `None` where there is none (outside the irradiance's
+    /// coverage): such a piece counts in neither.
+    pub fn at(
+        &self,
+        x: Vec3,
+        normal: Vec3,
+        irradiance: &impl Fn(Vec2) -> Option<Vec3>,
+    ) -> Scattered {
         let n = self.variances.len();
         let mut out = Scattered {
             irradiance: vec![Vec3::ZERO; n],
             reach: vec![0.0; n],
+            through_air: vec![Vec3::ZERO; n],
         };
+        let rise = normal.normalize_or_zero() / AIR_ELEVATION_DEG.to_radians().sin();
         let mut near = Vec::new();
         self.grid.near(x, self.extent(), &mut near);
         for &t in &near {
             let t = self.triangles[t as usize];
             let p = t.map(|i| self.positions[i as usize]);
             let uv = t.map(|i| self.uvs[i as usize]);
-            self.piece(x, p, uv, 0, irradiance, &mut out);
+            self.piece(x, rise, p, uv, 0, irradiance, &mut out);
         }
         out
     }
@@ -171,9 +190,11 @@ impl<'a> Diffusion<'a> {
             .all(|e| e.is_some_and(|e| (e - c).abs().max_element() <= tolerance))
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn piece(
         &self,
         x: Vec3,
+        rise: Vec3,
         p: [Vec3; 3],
         uv: [Vec2; 3],
         depth: u32,
@@ -206,7 +227,7 @@ impl<'a> Diffusion<'a> {
                 ([m20.0, m12.0, p[2]], [m20.1, m12.1, uv[2]]),
                 ([m01.0, m12.0, m20.0], [m01.1, m12.1, m20.1]),
             ] {
-                self.piece(x, q, w, depth + 1, irradiance, out);
+                self.piece(x, rise, q, w, depth + 1, irradiance, out);
             }
             return;
         }
@@ -220,11 +241,15 @@ impl<'a> Diffusion<'a> {
         // The profile by the edge-midpoint rule (exact for quadratics), E at the
         // centroid: E is a bilinear texture, smooth over a piece.
         let r2 = [(0, 1), (1, 2), (2, 0)].map(|(a, b)| x.distance_squared((p[a] + p[b]) * 0.5));
+        let air = (c - x).dot(rise) > d;
         for k in k0..self.variances.len() {
             let v = self.variances[k];
             let g = area / 3.0 * r2.iter().map(|&r2| gaussian(v, r2)).sum::<f32>();
             out.irradiance[k] += g * e;
             out.reach[k] += g;
+            if air {
+                out.through_air[k] += g * e;
+            }
         }
     }
 }
@@ -237,16 +262,24 @@ pub fn gaussian(v: f32, r2: f32) -> f32 {
 
 impl Scattered {
     /// Σ_k w_k M_k: the diffused irradiance with per-channel weights `weights`
-    /// (one per Gaussian); Gaussian k is divided by its reach C_k where
-    /// `normalised(k)` (near an open boundary of the mesh, as the texture-space
-    /// chain normalises by coverage).
-    pub fn diffuse(&self, weights: &[Vec3], normalised: impl Fn(usize) -> bool) -> Vec3 {
+    /// (one per Gaussian), with or without the light whose path crosses the air;
+    /// Gaussian k is divided by its reach C_k where `normalised(k)` (near an open
+    /// boundary of the mesh, as the texture-space chain normalises by coverage).
+    pub fn diffuse(
+        &self,
+        weights: &[Vec3],
+        through_air: bool,
+        normalised: impl Fn(usize) -> bool,
+    ) -> Vec3 {
         weights
             .iter()
             .zip(&self.irradiance)
+            .zip(&self.through_air)
             .zip(&self.reach)
             .enumerate()
-            .map(|(k, ((w, m), c))| {
+            .map(|(k, (((w, all), air), c))| {
+                let m = if through_air { *all } else { *all - *air };
+                let m = &m;
                 if normalised(k) && *c > 0.0 {
                     *w * *m / *c
                 } else {

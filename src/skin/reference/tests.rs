@@ -51,7 +51,7 @@ fn a_spot_on_a_plane_gives_the_profile() {
         Some(Vec3::splat(gaussian(v0, y.length_squared())))
     };
     for r in [0.0, 0.05, 0.15, 0.4, 1.0, 2.0, 4.0, 7.0] {
-        let s = diffusion.at(Vec3::new(r, 0.3 * r, 0.0), &spot);
+        let s = diffusion.at(Vec3::new(r, 0.3 * r, 0.0), Vec3::Z, &spot);
         let r2 = 1.09 * r * r;
         for (k, &v) in variances.iter().enumerate() {
             let want = gaussian(v + v0, r2);
@@ -72,7 +72,12 @@ fn a_spot_on_a_plane_gives_the_profile() {
         let want: Vec3 = (0..6)
             .map(|k| weights[k] * gaussian(variances[k] + v0, r2))
             .sum();
-        let got = s.diffuse(&weights, |_| false);
+        let got = s.diffuse(&weights, true, |_| false);
+        assert_eq!(
+            got,
+            s.diffuse(&weights, false, |_| false),
+            "no path leaves a plane"
+        );
         // Relative to the brightest channel: each Gaussian ends at its own 4σ, so
         // blue's tail (its two narrowest) at 1 mm is a few % short of the
         // untruncated profile, 3e-5 of red's value.
@@ -171,7 +176,11 @@ fn a_sphere_under_a_directional_light_matches_a_numerical_integral() {
     for theta_deg in [30.0f32, 80.0, 90.0, 100.0, 130.0] {
         let t = theta_deg.to_radians();
         let n = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
-        let s = diffusion.at(radius * n, &lit);
+        let s = diffusion.at(radius * n, n, &lit);
+        assert!(
+            s.through_air.iter().all(|a| *a == Vec3::ZERO),
+            "a convex body has no air paths"
+        );
         for (k, &v) in variances.iter().enumerate() {
             let want = sphere_integral(
                 radius as f64,
@@ -186,4 +195,32 @@ fn a_sphere_under_a_directional_light_matches_a_numerical_integral() {
             );
         }
     }
+}
+
+#[test]
+fn a_fold_sends_its_other_side_through_the_air() {
+    // An inside corner: the floor z = 0 (x ≥ 0) and the wall x = 0 (z ≥ 0), 30 mm
+    // each, facing each other. From a point of the floor 1 mm from the wall, the
+    // wall rises at up to 90°: its light crosses the air. The narrowest Gaussian
+    // (reach 0.32 mm) does not reach the wall.
+    let (variances, weights) = skin();
+    let p = [
+        Vec3::new(0.0, -15.0, 0.0),
+        Vec3::new(30.0, -15.0, 0.0),
+        Vec3::new(30.0, 15.0, 0.0),
+        Vec3::new(0.0, 15.0, 0.0),
+        Vec3::new(0.0, -15.0, 30.0),
+        Vec3::new(0.0, 15.0, 30.0),
+    ];
+    let uv = [Vec2::ZERO; 6];
+    let idx = [0, 1, 2, 0, 2, 3, 0, 3, 5, 0, 5, 4];
+    let diffusion = Diffusion::new(&p, &uv, &idx, &variances).unwrap();
+    let s = diffusion.at(Vec3::new(1.0, 0.0, 0.0), Vec3::Z, &|_| Some(Vec3::ONE));
+    assert_eq!(s.through_air[0], Vec3::ZERO);
+    assert!(s.through_air[5].x > 0.1 * s.irradiance[5].x, "{s:?}");
+    let (all, inside) = (
+        s.diffuse(&weights, true, |_| false),
+        s.diffuse(&weights, false, |_| false),
+    );
+    assert!(all.x > inside.x && inside.x > 0.9, "{all} {inside}");
 }
