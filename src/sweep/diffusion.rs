@@ -27,7 +27,7 @@ use crate::skin::SkinSettings;
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -156,10 +156,7 @@ pub fn run(
         ));
     }
     if let Some(dir) = &opts.out_dir {
-        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-            path: dir.display().to_string(),
-            source,
-        })?;
+        super::output::create_dir(dir)?;
     }
     let mut scene = Scene::load(opts.scene.clone())?;
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
@@ -183,31 +180,25 @@ pub fn run(
             Some(r) => r,
             None => reference.insert(exact(&scene, &skin, &levels[0], opts.stride)?),
         };
+        // The chain's diffused irradiance as the final pass combines its levels.
+        let chain_at = |uv: Vec2, e: Vec3| {
+            let blurred: Vec3 = levels[1..]
+                .iter()
+                .zip(&weights)
+                .map(|(level, w)| *w * level.at(uv).unwrap_or(e))
+                .sum();
+            e.lerp(blurred, skin.blur_amount)
+        };
         let diffused: Vec<Vec3> = reference
             .texels
             .iter()
             .zip(&reference.irradiance)
-            .map(|(t, &e)| {
-                let blurred: Vec3 = levels[1..]
-                    .iter()
-                    .zip(&weights)
-                    .map(|(level, w)| *w * level.at(t.uv).unwrap_or(e))
-                    .sum();
-                e.lerp(blurred, skin.blur_amount)
-            })
+            .map(|(t, &e)| chain_at(t.uv, e))
             .collect();
         let pixel_diffused: Vec<Vec3> = reference
             .pixels
             .iter()
-            .map(|p| {
-                let e = levels[0].at(p.uv).unwrap_or(Vec3::ZERO);
-                let blurred: Vec3 = levels[1..]
-                    .iter()
-                    .zip(&weights)
-                    .map(|(level, w)| *w * level.at(p.uv).unwrap_or(e))
-                    .sum();
-                e.lerp(blurred, skin.blur_amount)
-            })
+            .map(|p| chain_at(p.uv, levels[0].at(p.uv).unwrap_or(Vec3::ZERO)))
             .collect();
         let name = format!("{chain:?}").to_lowercase();
         let mut regions = reference
@@ -224,117 +215,20 @@ pub fn run(
                 )
             })
             .collect::<Result<Vec<_>>>()?;
-        // The diffuse term through the camera, shaded as the final pass, the
-        // chain's with the transmitted light the final pass adds (its view).
-        let (w, h) = (scene.file.render.width, scene.file.render.height);
         let transmitted = transmitted(ctx, &scene, &skin)?;
-        let shaded = |values: &[Vec3], plus: &[f32]| -> Vec<Vec3> {
-            reference
-                .pixels
-                .iter()
-                .zip(values)
-                .map(|(p, v)| {
-                    let extra = plus
-                        .get(4 * p.index..4 * p.index + 3)
-                        .map_or(Vec3::ZERO, Vec3::from_slice);
-                    p.shade * *v + extra
-                })
-                .collect()
-        };
-        let (want_px, inside_px, got_px) = (
-            shaded(&reference.pixel_diffused, &[]),
-            shaded(&reference.pixel_inside, &[]),
-            shaded(&pixel_diffused, &transmitted),
-        );
-        let screen = |values: &[Vec3]| {
-            let mut out = vec![0.0f32; 4 * (w * h) as usize];
-            for (p, v) in reference.pixels.iter().zip(values) {
-                out[4 * p.index..4 * p.index + 4].copy_from_slice(&v.extend(1.0).to_array());
-            }
-            out
-        };
-        let (screen_want, screen_got) = (screen(&want_px), screen(&got_px));
-        for (label, mask) in &reference.pixel_masks {
-            if mask.contains(&true) {
-                let label = format!("screen {w}×{h}: {label}");
-                regions.push(RegionRow::new(label, &want_px, &inside_px, &got_px, mask)?);
-            }
-        }
+        let screen = Screen::new(&scene, reference, &pixel_diffused, &transmitted);
+        regions.extend(screen.rows(reference)?);
         if let Some(dir) = &opts.out_dir {
-            if rows.is_empty() {
-                write_exr(&dir.join("screen-exact.exr"), w, h, &screen_want)?;
-            }
-            write_exr(&dir.join(format!("screen-{name}.exr")), w, h, &screen_got)?;
-            // Exact | chain | 10 × |difference|, at the exact image's exposure.
-            let post = PostSettings::resolve(&scene.file.render);
-            let exposure = match post.exposure {
-                Exposure::Given(ev) => ev,
-                Exposure::Metered => meter::exposure(&screen_want).ev,
-            };
-            let difference: Vec<f32> = screen_want
-                .iter()
-                .zip(&screen_got)
-                .enumerate()
-                .map(|(i, (a, b))| if i % 4 == 3 { *a } else { 10.0 * (a - b).abs() })
-                .collect();
-            let images = [&screen_want, &screen_got, &difference]
-                .map(|i| encode8(i, exposure, &post.display));
-            let row_bytes = 4 * w as usize;
-            let side_by_side: Vec<u8> = (0..h as usize)
-                .flat_map(|y| {
-                    images
-                        .iter()
-                        .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
-                })
-                .collect();
-            write_rgba8_png(
-                &dir.join(format!("screen-exact-{name}-difference.png")),
-                3 * w,
-                h,
-                &side_by_side,
-            )?;
-        }
-        if let Some(dir) = &opts.out_dir {
-            let side = skin.resolution.div_ceil(opts.stride);
-            let image = |values: &[Vec3]| {
-                let mut out = vec![0.0f32; 4 * (side * side) as usize];
-                for (t, v) in reference.texels.iter().zip(values) {
-                    let i = 4 * ((t.y / opts.stride) * side + t.x / opts.stride) as usize;
-                    out[i..i + 4].copy_from_slice(&v.extend(1.0).to_array());
-                }
-                out
-            };
-            let error: Vec<Vec3> = reference
-                .diffused
-                .iter()
-                .zip(&diffused)
-                .map(|(r, d)| (*d - *r) / r.max(Vec3::splat(1e-6)))
-                .collect();
-            if rows.is_empty() {
-                write_exr(
-                    &dir.join("reference.exr"),
-                    side,
-                    side,
-                    &image(&reference.diffused),
-                )?;
-                write_rgba8_png(
-                    &dir.join("regions.png"),
-                    side,
-                    side,
-                    &region_colours(reference, side, opts.stride),
-                )?;
-            }
-            write_exr(
-                &dir.join(format!("{name}.exr")),
-                side,
-                side,
-                &image(&diffused),
-            )?;
-            write_exr(
-                &dir.join(format!("{name}-error.exr")),
-                side,
-                side,
-                &image(&error),
+            let first = rows.is_empty();
+            screen.write(dir, &name, first, &scene)?;
+            write_uv(
+                dir,
+                &name,
+                first,
+                reference,
+                &diffused,
+                skin.resolution,
+                opts.stride,
             )?;
         }
         let row = DiffusionRow {
@@ -349,6 +243,156 @@ pub fn run(
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// The diffuse term through the camera, shaded as the final pass: the exact
+/// (with and without the paths through the air) and the chain's, with the
+/// transmitted light the final pass adds (its view), per mesh pixel.
+struct Screen {
+    width: u32,
+    height: u32,
+    exact: Vec<Vec3>,
+    inside: Vec<Vec3>,
+    chain: Vec<Vec3>,
+    /// Pixel index of each.
+    index: Vec<usize>,
+}
+
+impl Screen {
+    fn new(scene: &Scene, reference: &Reference, chain: &[Vec3], transmitted: &[f32]) -> Screen {
+        let shaded = |values: &[Vec3], plus: &[f32]| -> Vec<Vec3> {
+            reference
+                .pixels
+                .iter()
+                .zip(values)
+                .map(|(p, v)| {
+                    let extra = plus
+                        .get(4 * p.index..4 * p.index + 3)
+                        .map_or(Vec3::ZERO, Vec3::from_slice);
+                    p.shade * *v + extra
+                })
+                .collect()
+        };
+        Screen {
+            width: scene.file.render.width,
+            height: scene.file.render.height,
+            exact: shaded(&reference.pixel_diffused, &[]),
+            inside: shaded(&reference.pixel_inside, &[]),
+            chain: shaded(chain, transmitted),
+            index: reference.pixels.iter().map(|p| p.index).collect(),
+        }
+    }
+
+    /// A row per pixel mask of the reference.
+    fn rows(&self, reference: &Reference) -> Result<Vec<RegionRow>> {
+        let (w, h) = (self.width, self.height);
+        reference
+            .pixel_masks
+            .iter()
+            .filter(|(_, mask)| mask.contains(&true))
+            .map(|(label, mask)| {
+                let label = format!("screen {w}×{h}: {label}");
+                RegionRow::new(label, &self.exact, &self.inside, &self.chain, mask)
+            })
+            .collect()
+    }
+
+    /// RGBA image of `values` (alpha: the mesh's coverage).
+    fn image(&self, values: &[Vec3]) -> Vec<f32> {
+        let mut out = vec![0.0f32; 4 * (self.width * self.height) as usize];
+        for (&i, v) in self.index.iter().zip(values) {
+            out[4 * i..4 * i + 4].copy_from_slice(&v.extend(1.0).to_array());
+        }
+        out
+    }
+
+    /// `screen-exact.exr` (with `first`), `screen-NAME.exr` and exact | chain |
+    /// 10 × |difference| as a PNG at the exact image's exposure.
+    fn write(&self, dir: &Path, name: &str, first: bool, scene: &Scene) -> Result<()> {
+        let (w, h) = (self.width, self.height);
+        let (exact, chain) = (self.image(&self.exact), self.image(&self.chain));
+        if first {
+            write_exr(&dir.join("screen-exact.exr"), w, h, &exact)?;
+        }
+        write_exr(&dir.join(format!("screen-{name}.exr")), w, h, &chain)?;
+        let post = PostSettings::resolve(&scene.file.render);
+        let exposure = match post.exposure {
+            Exposure::Given(ev) => ev,
+            Exposure::Metered => meter::exposure(&exact).ev,
+        };
+        let difference: Vec<f32> = exact
+            .iter()
+            .zip(&chain)
+            .enumerate()
+            .map(|(i, (a, b))| if i % 4 == 3 { *a } else { 10.0 * (a - b).abs() })
+            .collect();
+        let images = [&exact, &chain, &difference].map(|i| encode8(i, exposure, &post.display));
+        let row_bytes = 4 * w as usize;
+        let side_by_side: Vec<u8> = (0..h as usize)
+            .flat_map(|y| {
+                images
+                    .iter()
+                    .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
+            })
+            .collect();
+        write_rgba8_png(
+            &dir.join(format!("screen-exact-{name}-difference.png")),
+            3 * w,
+            h,
+            &side_by_side,
+        )
+    }
+}
+
+/// The UV-space images (resolution / stride a side): `reference.exr` and
+/// `regions.png` (with `first`), the chain's `NAME.exr` and its relative error
+/// per channel `NAME-error.exr`.
+fn write_uv(
+    dir: &Path,
+    name: &str,
+    first: bool,
+    reference: &Reference,
+    diffused: &[Vec3],
+    resolution: u32,
+    stride: u32,
+) -> Result<()> {
+    let side = resolution.div_ceil(stride);
+    let image = |values: &[Vec3]| {
+        let mut out = vec![0.0f32; 4 * (side * side) as usize];
+        for (t, v) in reference.texels.iter().zip(values) {
+            let i = 4 * ((t.y / stride) * side + t.x / stride) as usize;
+            out[i..i + 4].copy_from_slice(&v.extend(1.0).to_array());
+        }
+        out
+    };
+    let error: Vec<Vec3> = reference
+        .diffused
+        .iter()
+        .zip(diffused)
+        .map(|(r, d)| (*d - *r) / r.max(Vec3::splat(1e-6)))
+        .collect();
+    if first {
+        write_exr(
+            &dir.join("reference.exr"),
+            side,
+            side,
+            &image(&reference.diffused),
+        )?;
+        let colours = region_colours(reference, side, stride);
+        write_rgba8_png(&dir.join("regions.png"), side, side, &colours)?;
+    }
+    write_exr(
+        &dir.join(format!("{name}.exr")),
+        side,
+        side,
+        &image(diffused),
+    )?;
+    write_exr(
+        &dir.join(format!("{name}-error.exr")),
+        side,
+        side,
+        &image(&error),
+    )
 }
 
 /// A read-back level: coverage-premultiplied RGBA, sampled as the final pass
@@ -446,63 +490,10 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         .unzip();
     let seconds = start.elapsed().as_secs_f64();
     drop(task);
-    let ids = region_ids(scene, &texels);
-    let pixel_ids = region_ids(
-        scene,
-        &pixels
-            .iter()
-            .map(|p| Texel {
-                x: 0,
-                y: 0,
-                uv: p.uv,
-                position: p.position,
-                normal: Vec3::ZERO,
-            })
-            .collect::<Vec<_>>(),
-    );
-    let ears = REGION_NAMES
-        .iter()
-        .position(|n| *n == "ears")
-        .expect("a region");
-    let pixel_masks = vec![
-        (
-            "face".to_string(),
-            pixel_ids
-                .iter()
-                .map(|&i| i != REGION_NAMES.len() - 1)
-                .collect(),
-        ),
-        (
-            "ears".to_string(),
-            pixel_ids.iter().map(|&i| i == ears).collect(),
-        ),
-        ("all".to_string(), vec![true; pixels.len()]),
-    ];
-    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    let neck = REGION_NAMES.len() - 1;
-    let mut masks = vec![("face".to_string(), ids.iter().map(|&i| i != neck).collect())];
-    masks.extend(
-        REGION_NAMES
-            .iter()
-            .enumerate()
-            .map(|(k, name)| (name.to_string(), ids.iter().map(|&i| i == k).collect())),
-    );
-    masks.push((
-        format!("UV seams (≤ {SEAM_MM} mm)"),
-        texels
-            .iter()
-            .map(|t| edges.to_seam(t.position).is_some_and(|d| d <= SEAM_MM))
-            .collect(),
-    ));
-    masks.push((
-        format!("scattering > {:.0} %", 100.0 * SCATTERING_CHANGE),
-        diffused
-            .iter()
-            .zip(&e)
-            .map(|(&d, &e)| (lum(d) - lum(e)).abs() > SCATTERING_CHANGE * lum(d))
-            .collect(),
-    ));
-    masks.push(("all".to_string(), vec![true; texels.len()]));
+    let ids = region_ids(scene, texels.iter().map(|t| (t.uv, t.position)));
+    let pixel_ids = region_ids(scene, pixels.iter().map(|p| (p.uv, p.position)));
+    let masks = texel_masks(&ids, &texels, &edges, &diffused, &e);
+    let pixel_masks = pixel_masks(&pixel_ids);
     Ok(Reference {
         texels,
         irradiance: e,
@@ -574,10 +565,63 @@ fn transmitted(ctx: &Arc<Context>, scene: &Scene, skin: &SkinSettings) -> Result
     Ok(out.hdr.unwrap_or_default())
 }
 
-/// The face region (skin::specular::REGION_NAMES) of each texel: from the
+/// The comparison's texel masks: the face, each region, the seams, where
+/// scattering changes the light by more than SCATTERING_CHANGE, all.
+fn texel_masks(
+    ids: &[usize],
+    texels: &[Texel],
+    edges: &MeshEdges,
+    diffused: &[Vec3],
+    irradiance: &[Vec3],
+) -> Vec<(String, Vec<bool>)> {
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let mut masks = region_masks(ids);
+    masks.push((
+        format!("UV seams (≤ {SEAM_MM} mm)"),
+        texels
+            .iter()
+            .map(|t| edges.to_seam(t.position).is_some_and(|d| d <= SEAM_MM))
+            .collect(),
+    ));
+    masks.push((
+        format!("scattering > {:.0} %", 100.0 * SCATTERING_CHANGE),
+        diffused
+            .iter()
+            .zip(irradiance)
+            .map(|(&d, &e)| (lum(d) - lum(e)).abs() > SCATTERING_CHANGE * lum(d))
+            .collect(),
+    ));
+    masks.push(("all".to_string(), vec![true; texels.len()]));
+    masks
+}
+
+/// The face (every region but the last, neck/other) and each region.
+fn region_masks(ids: &[usize]) -> Vec<(String, Vec<bool>)> {
+    let neck = REGION_NAMES.len() - 1;
+    std::iter::once(("face".to_string(), ids.iter().map(|&i| i != neck).collect()))
+        .chain(
+            REGION_NAMES
+                .iter()
+                .enumerate()
+                .map(|(k, name)| (name.to_string(), ids.iter().map(|&i| i == k).collect())),
+        )
+        .collect()
+}
+
+/// The camera's pixel masks: the face, the ears, all.
+fn pixel_masks(ids: &[usize]) -> Vec<(String, Vec<bool>)> {
+    let mut masks: Vec<_> = region_masks(ids)
+        .into_iter()
+        .filter(|(name, _)| name == "face" || name == "ears")
+        .collect();
+    masks.push(("all".to_string(), vec![true; ids.len()]));
+    masks
+}
+
+/// The face region (skin::specular::REGION_NAMES) of each (uv, position): from the
 /// scene's region map where it has one (a file's, or the built-in head's), else
 /// from the mesh by [`landmark_region`].
-fn region_ids(scene: &Scene, texels: &[Texel]) -> Vec<usize> {
+fn region_ids(scene: &Scene, points: impl Iterator<Item = (Vec2, Vec3)>) -> Vec<usize> {
     let last = REGION_NAMES.len() - 1;
     if scene.file.textures.regions.is_none() && scene.file.mesh.is_some() {
         let nose = scene
@@ -587,16 +631,12 @@ fn region_ids(scene: &Scene, texels: &[Texel]) -> Vec<usize> {
             .copied()
             .reduce(|a, b| if b.z > a.z { b } else { a })
             .unwrap_or_default();
-        return texels
-            .iter()
-            .map(|t| landmark_region(t.position - nose))
-            .collect();
+        return points.map(|(_, x)| landmark_region(x - nose)).collect();
     }
     let r = &scene.regions;
-    texels
-        .iter()
-        .map(|t| {
-            let p = (t.uv * Vec2::new(r.width as f32, r.height as f32)).as_uvec2();
+    points
+        .map(|(uv, _)| {
+            let p = (uv * Vec2::new(r.width as f32, r.height as f32)).as_uvec2();
             let i = 4 * (p.y.min(r.height - 1) * r.width + p.x.min(r.width - 1)) as usize;
             (r.rgba8[i] as usize).min(last)
         })

@@ -68,10 +68,7 @@ pub fn run(
         ));
     }
     if let Some(dir) = &opts.out_dir {
-        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-            path: dir.display().to_string(),
-            source,
-        })?;
+        super::output::create_dir(dir)?;
     }
     let mut rows = Vec::new();
     for (k, env) in opts.environments.iter().enumerate() {

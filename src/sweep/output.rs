@@ -17,10 +17,15 @@ pub fn write_csv_and_plots(sweep: &Sweep, dir: &Path) -> Result<()> {
 
 /// `sweep.json`, `sweep.csv` and the plots into `dir` (created).
 pub fn write_all(sweep: &Sweep, dir: &Path) -> Result<()> {
+    create_dir(dir)?;
+    write_atomic(&dir.join("sweep.json"), &json(sweep)?)?;
+    write_csv_and_plots(sweep, dir)
+}
+
+/// Creates `dir` and its parents; an error names it.
+pub fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
         path: dir.display().to_string(),
         source,
-    })?;
-    write_atomic(&dir.join("sweep.json"), &json(sweep)?)?;
-    write_csv_and_plots(sweep, dir)
+    })
 }
