@@ -158,3 +158,155 @@ fn texture_space_diffusion_against_the_exact_reference() {
         );
     }
 }
+
+/// The nose's shadow on the cheek under one directional light (black
+/// environment), `--view direct` against the CPU reference's shadow rays: the
+/// visibility V = image / image without shadows on both sides, the mean offset
+/// of the V = ½ line (positive: dermis's edge lies inside the reference's
+/// shadow) and the width of the 10–90 % penumbra, in mm on the cheek, for a
+/// hard light and one 3° across, at two shadow-map resolutions (docs/lighting.md,
+/// "The nose's shadow edge"). Issue 22's target (within 0.25 mm, penumbra within
+/// 25 %) is not met at the default 2048²; the assertions hold what a map of the
+/// mesh's bounding sphere gives, and that a finer map comes closer.
+#[test]
+fn nose_shadow_edge_against_the_reference() {
+    use dermis::scene::env::EnvSource;
+    use dermis::scene::file::{Light, LightKind, LightsMode};
+    let (w, h) = (160, 160);
+    let mut file = scene_by_name(None).unwrap();
+    (file.render.width, file.render.height) = (w, h);
+    file.render.skybox = false;
+    file.render.irradiance_resolution = 256;
+    file.skin.occlusion = Occlusion::Off;
+    file.environment.source = EnvSource::Uniform(glam::Vec3::ZERO);
+    file.environment.lights = LightsMode::Count(0);
+    // From the subject's left, a little above and in front: the nose shades the
+    // right cheek beside it.
+    file.lights = vec![Light {
+        kind: LightKind::Directional,
+        direction: Some([-0.85, -0.25, -0.45]),
+        position: None,
+        color: [1.0; 3],
+        intensity: 1.0,
+        shadow: true,
+        angular_diameter_deg: 0.0,
+    }];
+    // 24 mm square on the cheek beside the nose, 300 mm away: 0.15 mm per pixel.
+    file.camera.position = Some([-20.0, 45.0, 400.0]);
+    file.camera.target = Some([-20.0, 45.0, 100.0]);
+    file.camera.orbit = None;
+    file.camera.fov_deg = 2.0 * (12.0f32 / 300.0).atan().to_degrees();
+    let mm_per_pixel = 24.0 / h as f32;
+    let settings = Settings {
+        target_rel_err: 0.01,
+        ..Settings::default()
+    };
+    let visibility = |lit: &[f32], unshadowed: &[f32]| -> Vec<Option<f32>> {
+        let peak = unshadowed.chunks_exact(4).map(|p| p[0]).fold(0.0, f32::max);
+        lit.chunks_exact(4)
+            .zip(unshadowed.chunks_exact(4))
+            .map(|(a, b)| (b[3] > 0.5 && b[0] > 0.05 * peak).then(|| (a[0] / b[0]).clamp(0.0, 1.0)))
+            .collect()
+    };
+    let with = |diameter: f32, shadow: bool, resolution: u32| {
+        let mut f = file.clone();
+        f.lights[0].angular_diameter_deg = diameter;
+        f.lights[0].shadow = shadow;
+        f.render.shadow_resolution = resolution;
+        Scene::load(f).unwrap()
+    };
+    let mut results = Vec::new();
+    for diameter in [0.0f32, 3.0] {
+        let reference = |shadow| {
+            render_view(&with(diameter, shadow, 2048), w, h, &settings)
+                .unwrap()
+                .rgba
+        };
+        let v_ref = visibility(&reference(true), &reference(false));
+        let rows: Vec<[f32; 5]> = common::with_gpu(|ctx| {
+            [2048u32, 8192]
+                .map(|resolution| {
+                    let render = |shadow| {
+                        let opts = RenderOptions {
+                            hdr: true,
+                            view: View::named("direct"),
+                            ..RenderOptions::default()
+                        };
+                        let scene = with(diameter, shadow, resolution);
+                        render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()
+                    };
+                    let v = visibility(&render(true), &render(false));
+                    let (offset, penumbra, penumbra_ref) = edge(&v, &v_ref, w as usize);
+                    [diameter, resolution as f32, offset, penumbra, penumbra_ref]
+                })
+                .map(|[d, r, o, p, q]| [d, r, o * mm_per_pixel, p * mm_per_pixel, q * mm_per_pixel])
+                .to_vec()
+        });
+        results.extend(rows);
+    }
+    for [diameter, resolution, offset, penumbra, penumbra_ref] in &results {
+        println!(
+            "light {diameter}°, shadow map {resolution}²: edge {offset:+.2} mm into the \
+             reference's shadow, penumbra {penumbra:.2} mm (reference {penumbra_ref:.2} mm)"
+        );
+    }
+    for pair in results.chunks(2) {
+        let (coarse, fine) = (pair[0], pair[1]);
+        assert!(coarse[2].abs() < 1.5, "{results:?}");
+        // A finer map moves the edge toward the reference's.
+        assert!(fine[2].abs() <= coarse[2].abs() + 0.05, "{results:?}");
+    }
+    // The 3° source's penumbra is the wider, on both sides (measured 1.5 mm in
+    // the reference; the hard light's is one shadow-map texel or two).
+    assert!(results[2][4] > results[0][4] + 0.5, "{results:?}");
+    assert!(results[2][3] > results[0][3] + 0.5, "{results:?}");
+}
+
+/// (offset, penumbra, reference penumbra) in pixels per pixel of edge: the
+/// signed area between the V = ½ lines (dermis lit where the reference is in
+/// shadow counts positive) and the 10–90 % areas of V smoothed 3 × 3, each over
+/// the reference edge's length (its V = ½ transitions between neighbouring
+/// pixels).
+fn edge(v: &[Option<f32>], v_ref: &[Option<f32>], w: usize) -> (f32, f32, f32) {
+    let both: Vec<Option<(f32, f32)>> = v.iter().zip(v_ref).map(|(a, b)| a.zip(*b)).collect();
+    let mut length = 0.0f32;
+    for (i, p) in both.iter().enumerate() {
+        let Some((_, r)) = p else { continue };
+        let right = (i % w + 1 < w).then_some(i + 1);
+        for j in right.into_iter().chain([i + w]) {
+            if let Some(Some((_, s))) = both.get(j) {
+                length += f32::from((*r > 0.5) != (*s > 0.5));
+            }
+        }
+    }
+    assert!(length > 20.0, "no shadow edge in view ({length} pixels)");
+    // The penumbrae of both after a 3 × 3 mean, so that the soft shadows'
+    // per-pixel noise (12 turned taps) does not count as penumbra.
+    let smooth = |pick: fn((f32, f32)) -> f32| -> Vec<Option<f32>> {
+        (0..both.len())
+            .map(|i| {
+                both[i]?;
+                let (x, y) = ((i % w) as i64, (i / w) as i64);
+                let near: Vec<f32> = (-1..=1)
+                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                    .filter(|&(x, y)| x >= 0 && y >= 0 && x < w as i64)
+                    .filter_map(|(x, y)| both.get(y as usize * w + x as usize).copied().flatten())
+                    .map(pick)
+                    .collect();
+                Some(near.iter().sum::<f32>() / near.len() as f32)
+            })
+            .collect()
+    };
+    let band =
+        |v: &[Option<f32>]| v.iter().flatten().filter(|&&v| v > 0.1 && v < 0.9).count() as f32;
+    let offset: f32 = both
+        .iter()
+        .flatten()
+        .map(|(a, r)| f32::from(*a > 0.5 && *r <= 0.5) - f32::from(*a <= 0.5 && *r > 0.5))
+        .sum();
+    (
+        offset / length,
+        band(&smooth(|p| p.0)) / length,
+        band(&smooth(|p| p.1)) / length,
+    )
+}
