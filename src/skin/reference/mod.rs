@@ -5,14 +5,15 @@
 //!
 //! At a point x, per Gaussian k of the profile,
 //! `M_k(x) = ∫ G(v_k, |x − y|) E(y) dA(y)` and the profile's reach
-//! `C_k(x) = ∫ G(v_k, |x − y|) dA(y)` (1 on an unbounded plane), over the mesh's
-//! triangles within 4σ of the widest Gaussian (the extent; the profile
-//! beyond holds e⁻⁸ of its energy; a piece counts when its centroid is within).
-//! Each triangle is split in four until its pieces are smaller than
-//! [`LEAF_SIGMA`] σ of the narrowest Gaussian that reaches them, and each piece
-//! counts once, by the edge-midpoint rule: fine near x, coarse far away
-//! (Jensen & Buhler's hierarchy, built per query). E is read at the piece's UV,
-//! so the reference sees the same irradiance as the texture-space chain.
+//! `C_k(x) = ∫ G(v_k, |x − y|) dA(y)` (1 on an unbounded plane), each Gaussian
+//! out to its own 4σ (the extent; beyond lies e⁻⁸ of its energy).
+//! Each triangle near x is split in four until its pieces are smaller than
+//! [`LEAF_SIGMA`] σ of the narrowest Gaussian that reaches them (and, where E
+//! changes across a piece, down to [`FINEST_SIGMA`] σ), and each piece counts
+//! once, by the edge-midpoint rule: fine near x, coarse far away (Jensen &
+//! Buhler's hierarchy, built per query). E is read at the piece's UV, so the
+//! reference sees the same irradiance as the texture-space chain. The light
+//! whose straight path crosses the air is kept apart ([`Scattered::through_air`]).
 //!
 //! Files: `grid.rs` (which triangles are near), `texels.rs` (where a texel sits
 //! on the surface), `edges.rs` (UV seams and open boundaries).
