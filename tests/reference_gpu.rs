@@ -167,7 +167,8 @@ fn texture_space_diffusion_against_the_exact_reference() {
 /// hard light and one 3° across, at two shadow-map resolutions (docs/lighting.md,
 /// "The nose's shadow edge"). Issue 22's target (within 0.25 mm, penumbra within
 /// 25 %) is not met at the default 2048²; the assertions hold what a map of the
-/// mesh's bounding sphere gives, and that a finer map comes closer.
+/// mesh's bounding sphere gives, that a finer map comes closer, and the soft
+/// penumbra's width.
 #[test]
 fn nose_shadow_edge_against_the_reference() {
     use dermis::scene::env::EnvSource;
@@ -176,7 +177,9 @@ fn nose_shadow_edge_against_the_reference() {
     let mut file = scene_by_name(None).unwrap();
     (file.render.width, file.render.height) = (w, h);
     file.render.skybox = false;
-    file.render.irradiance_resolution = 256;
+    // The soft lights' visibility is stored in UV space at half the irradiance
+    // resolution (light::visibility): 2048 gives its finest, 1024² (~0.6 mm).
+    file.render.irradiance_resolution = 2048;
     file.skin.occlusion = Occlusion::Off;
     file.environment.source = EnvSource::Uniform(glam::Vec3::ZERO);
     file.environment.lights = LightsMode::Count(0);
@@ -256,10 +259,13 @@ fn nose_shadow_edge_against_the_reference() {
         // A finer map moves the edge toward the reference's.
         assert!(fine[2].abs() <= coarse[2].abs() + 0.05, "{results:?}");
     }
-    // The 3° source's penumbra is the wider, on both sides (measured 1.5 mm in
-    // the reference; the hard light's is one shadow-map texel or two).
+    // The 3° source's penumbra (1.6 mm in the reference; the hard light's is a
+    // pixel or two) within half of the reference's at both resolutions
+    // (measured: 28 % and 12 % narrower).
     assert!(results[2][4] > results[0][4] + 0.5, "{results:?}");
-    assert!(results[2][3] > results[0][3] + 0.5, "{results:?}");
+    for soft in &results[2..] {
+        assert!((soft[3] / soft[4] - 1.0).abs() < 0.5, "{results:?}");
+    }
 }
 
 /// (offset, penumbra, reference penumbra) in pixels per pixel of edge: the
