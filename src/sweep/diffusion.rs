@@ -9,13 +9,11 @@
 //! by more than 20 %, and over the face. docs/skin.md, "Exact diffusion".
 
 use super::metric::{relative, RelativeError};
+use super::output::write_side_by_side;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::light::occlusion::Bvh;
 use crate::light::reference::{bilinear, rgba8};
-use crate::post::meter;
-use crate::post::tonemap::encode8;
-use crate::post::{Exposure, PostSettings};
 use crate::render::output::{write_exr, write_rgba8_png};
 use crate::render::progress::Task;
 use crate::render::{render_scene, stored_images, RenderOptions, View};
@@ -315,32 +313,15 @@ impl Screen {
             write_exr(&dir.join("screen-exact.exr"), w, h, &exact)?;
         }
         write_exr(&dir.join(format!("screen-{name}.exr")), w, h, &chain)?;
-        let post = PostSettings::resolve(&scene.file.render);
-        let exposure = match post.exposure {
-            Exposure::Given(ev) => ev,
-            Exposure::Metered => meter::exposure(&exact).ev,
-        };
         let difference: Vec<f32> = exact
             .iter()
             .zip(&chain)
             .enumerate()
             .map(|(i, (a, b))| if i % 4 == 3 { *a } else { 10.0 * (a - b).abs() })
             .collect();
-        let images = [&exact, &chain, &difference].map(|i| encode8(i, exposure, &post.display));
-        let row_bytes = 4 * w as usize;
-        let side_by_side: Vec<u8> = (0..h as usize)
-            .flat_map(|y| {
-                images
-                    .iter()
-                    .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
-            })
-            .collect();
-        write_rgba8_png(
-            &dir.join(format!("screen-exact-{name}-difference.png")),
-            3 * w,
-            h,
-            &side_by_side,
-        )
+        let images: [&[f32]; 3] = [&exact, &chain, &difference];
+        let path = dir.join(format!("screen-exact-{name}-difference.png"));
+        write_side_by_side(&path, (w, h), &images, &scene.file.render)
     }
 }
 

@@ -10,13 +10,11 @@
 //! skybox off (alpha is the mesh's coverage), so the error is the lighting's.
 
 use super::metric::{relative, RelativeError};
+use super::output::write_side_by_side;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::light::reference::{render_view_with, Settings};
-use crate::post::meter;
-use crate::post::tonemap::encode8;
-use crate::post::{Exposure, PostSettings};
-use crate::render::output::{write_exr, write_rgba8_png};
+use crate::render::output::write_exr;
 use crate::render::progress::Task;
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::env::EnvSource;
@@ -124,21 +122,13 @@ pub fn run(
             write_exr(&name("sh9.exr"), w, h, &sh9)?;
             write_exr(&name("sh9-lights.exr"), w, h, &lit)?;
             // All three at the reference's exposure (given, or metered on it).
-            let post = PostSettings::resolve(&scene.file.render);
-            let exposure = match post.exposure {
-                Exposure::Given(ev) => ev,
-                Exposure::Metered => meter::exposure(&reference.rgba).ev,
-            };
-            let images = [&reference.rgba, &sh9, &lit].map(|i| encode8(i, exposure, &post.display));
-            let row_bytes = 4 * w as usize;
-            let side_by_side: Vec<u8> = (0..h as usize)
-                .flat_map(|y| {
-                    images
-                        .iter()
-                        .flat_map(move |i| i[y * row_bytes..(y + 1) * row_bytes].to_vec())
-                })
-                .collect();
-            write_rgba8_png(&name("reference-sh9-lights.png"), 3 * w, h, &side_by_side)?;
+            let images: [&[f32]; 3] = [&reference.rgba, &sh9, &lit];
+            write_side_by_side(
+                &name("reference-sh9-lights.png"),
+                (w, h),
+                &images,
+                &scene.file.render,
+            )?;
         }
         progress(&row);
         rows.push(row);
