@@ -19,8 +19,20 @@ impl Xvfb {
     fn start() -> Xvfb {
         // A display number no other test (of this run or another) is likely to hold.
         static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let n = 90 + (std::process::id() % 100) * 4 + k;
+        // An X server killed without its clean-up (SIGKILL, as Drop does) leaves
+        // its lock file and socket behind: a number holding either is skipped,
+        // else the stale socket would pass for a server that never started.
+        let free = |n: u32| {
+            !PathBuf::from(format!("/tmp/.X{n}-lock")).exists()
+                && !PathBuf::from(format!("/tmp/.X11-unix/X{n}")).exists()
+        };
+        let n = loop {
+            let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let n = 90 + (std::process::id() % 100) * 4 + k;
+            if free(n) {
+                break n;
+            }
+        };
         let display = format!(":{n}");
         let child = Command::new("Xvfb")
             .args([&display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
