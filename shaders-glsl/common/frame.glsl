@@ -7,6 +7,8 @@ layout(std140, binding = 0) uniform Frame {
     vec4 light_color[8];    // rgb: irradiance facing the light (point: at 1000 mm); w: shadow texel, mm (0: unshadowed)
     mat4 light_shadow[8];   // world → (atlas u, v, depth) after the divide by w
     vec4 light_params[8];   // x: tan(angular radius), y: shadow depth range mm, z: m² widening, w: point light's shadow near plane mm
+    mat4 light_focus[8];    // world → atlas (u, v, depth) in the light's focus tile: where the camera looks
+    vec4 light_focus_tile[8];   // x: the focus tile's texel, mm (0: none); y: its nearest surface's depth; zw: its lowest atlas corner
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
     vec4 params;            // x: 0 (free), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;

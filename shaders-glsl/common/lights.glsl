@@ -45,13 +45,46 @@ int soft_slot(int i) {
     return bitCount(SOFT_LIGHTS & ((1 << i) - 1));
 }
 
-// The atlas point (u, v, depth) light i looks up for x (surface normal ng,
-// direction l to the light, dist to a point light), with the acne offsets.
-vec4 shadow_point(int i, vec3 x, vec3 ng, vec3 l, float dist) {
-    float texel = frame.light_color[i].w * (frame.light_vec[i].w > 0.5 ? dist : 1.0);
+// One of light i's shadow maps: world to atlas (u, v, depth), its texel (mm)
+// and the depth of the nearest surface it holds (no blocker lies nearer).
+struct ShadowMap {
+    mat4 to_atlas;
+    float texel;
+    float nearest;
+};
+
+// Texels around a lookup that the acne offsets can move it (2.5 along the
+// normal, 1 along the light) and the 3×3 PCF reach.
+const float LOOKUP_REACH_TEXELS = 6.0;
+
+// Light i's map for x: its focus tile (light/shadow.rs: the window of the whole
+// map that holds what the camera sees, at the same resolution) where the lookup,
+// its filter and, for a source of angular radius atan(tan_r), the blocker search
+// lie inside it and that search needs at most MAX_SOFT_TEXELS of it; else the
+// tile of the whole mesh.
+ShadowMap shadow_map(int i, vec3 x, float tan_r) {
+    vec4 tile = frame.light_focus_tile[i];
+    if (tile.x > 0.0) {
+        vec4 s = frame.light_focus[i] * vec4(x, 1.0);
+        vec3 p = s.xyz / s.w;
+        float search = (p.z - tile.y) * frame.light_params[i].y * tan_r / tile.x;
+        vec2 reach = (LOOKUP_REACH_TEXELS + search) / vec2(textureSize(shadow_atlas, 0));
+        vec2 lo = tile.zw + reach, hi = tile.zw + 1.0 / frame.params.zw - reach;
+        if (search <= MAX_SOFT_TEXELS && all(greaterThan(p.xy, lo)) && all(lessThan(p.xy, hi))) {
+            return ShadowMap(frame.light_focus[i], tile.x, tile.y);
+        }
+    }
+    return ShadowMap(frame.light_shadow[i], frame.light_color[i].w, 0.0);
+}
+
+// The atlas point (u, v, depth) of map m for x (surface normal ng, direction l
+// to the light, dist to a point light: m's texel is per mm of it), with the
+// acne offsets.
+vec4 shadow_point(ShadowMap m, bool point, vec3 x, vec3 ng, vec3 l, float dist) {
+    float texel = m.texel * (point ? dist : 1.0);
     vec3 side = dot(ng, l) < 0.0 ? -ng : ng;
     vec3 p = x + texel * (NORMAL_OFFSET_TEXELS * side + LIGHT_OFFSET_TEXELS * l);
-    vec4 s = frame.light_shadow[i] * vec4(p, 1.0);
+    vec4 s = m.to_atlas * vec4(p, 1.0);
     return vec4(s.xyz / s.w, 1.0);
 }
 
@@ -62,18 +95,20 @@ layout(binding = SHADOW_DEPTH) uniform sampler2D shadow_depth;
 // through the shaded point with normal ng, seen by light i's (orthographic) map,
 // so that wide kernels compare each tap with the surface under it rather than
 // with the point's own depth. Clamped where the plane is seen nearly edge-on.
-vec2 receiver_slope(int i, vec3 ng, vec2 step) {
+vec2 receiver_slope(int i, ShadowMap m, vec3 ng, vec2 step) {
     vec3 t1 = normalize(cross(ng, abs(ng.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
     vec3 t2 = cross(ng, t1);
-    vec3 a = (frame.light_shadow[i] * vec4(t1, 0.0)).xyz;
-    vec3 b = (frame.light_shadow[i] * vec4(t2, 0.0)).xyz;
+    vec3 a = (m.to_atlas * vec4(t1, 0.0)).xyz;
+    vec3 b = (m.to_atlas * vec4(t2, 0.0)).xyz;
     mat2 j = mat2(a.xy, b.xy);
     if (abs(determinant(j)) < 1e-12) return vec2(0.0);
     vec2 slope = vec2(a.z, b.z) * inverse(j);
-    // At most an 80° tilt: tan 80° = 5.7 mm of depth per mm, one texel (texel mm
-    // across, `step` in uv) per depth range (mm).
-    float limit = 5.7 * frame.light_color[i].w / frame.light_params[i].y / max(step.x, step.y);
-    float len = length(slope);
+    // At most an 80° tilt: tan 80° = 5.7 mm of depth per mm, per texel (texel
+    // mm across) in units of the depth range (mm); per texel, since an atlas of
+    // 2 × 1 tiles has texels twice as narrow in u as in v.
+    vec2 per_texel = slope * step;
+    float limit = 5.7 * m.texel / frame.light_params[i].y;
+    float len = length(per_texel);
     return len > limit ? slope * (limit / len) : slope;
 }
 
@@ -81,18 +116,18 @@ vec2 receiver_slope(int i, vec3 ng, vec2 step) {
 // point s (u, v, depth) on a surface of normal ng: blockers found within the
 // reach of the source's cone give the penumbra's radius, (receiver − blocker
 // distance)·tan r, averaged over the blockers (Fernando 2005).
-float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
+float soft_visibility(int i, ShadowMap m, vec3 s, vec3 ng, vec2 step) {
     float tan_r = frame.light_params[i].x;
     float range = frame.light_params[i].y;
-    float texel = frame.light_color[i].w;
+    float texel = m.texel;
     // Taps stay inside this light's tile of the atlas.
     vec2 tiles = frame.params.zw;
     vec2 lo = floor(s.xy * tiles) / tiles + 0.5 * step;
     vec2 hi = lo + 1.0 / tiles - step;
-    vec2 slope = receiver_slope(i, ng, step);
+    vec2 slope = receiver_slope(i, m, ng, step);
     float eps = texel / range;   // one texel of depth
     mat2 turn = soft_shadow_turn();
-    float search = clamp(s.z * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
+    float search = clamp((s.z - m.nearest) * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float distance = 0.0, count = 0.0;
     for (int k = 0; k < BLOCKER_TAPS; ++k) {
         vec2 d = turn * vogel_tap(k, BLOCKER_TAPS) * search * step;
@@ -119,9 +154,10 @@ float soft_visibility(int i, vec3 s, vec3 ng, vec2 step) {
 
 // Soft light i's visibility at x (normal ng), from the atlas.
 float soft_shadow(int i, vec3 x, vec3 ng) {
-    vec3 s = shadow_point(i, x, ng, frame.light_vec[i].xyz, 1.0).xyz;
+    ShadowMap m = shadow_map(i, x, frame.light_params[i].x);
+    vec3 s = shadow_point(m, false, x, ng, frame.light_vec[i].xyz, 1.0).xyz;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
-    return soft_visibility(i, s, ng, 1.0 / vec2(textureSize(shadow_atlas, 0)));
+    return soft_visibility(i, m, s, ng, 1.0 / vec2(textureSize(shadow_atlas, 0)));
 }
 #endif
 
@@ -140,7 +176,7 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 // is dist·(1 − axial(stored)/axial(x)), dist = |light − x|
 // (light::shadow::ShadowView::thickness_mm mirrors this).
 float shadow_thickness(int i, vec3 x, float dist) {
-    vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
+    vec4 s = shadow_map(i, x, 0.0).to_atlas * vec4(x, 1.0);
     vec3 p = s.xyz / s.w;
     vec2 size = vec2(textureSize(shadow_depth, 0));
     // The taps stay inside this light's tile of the atlas.
@@ -189,7 +225,8 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
 #ifdef SOFT_VISIBILITY
     if ((SOFT_LIGHTS & (1 << i)) != 0) return stored_soft_visibility(i, uv);
 #endif
-    vec3 s = shadow_point(i, x, ng, l, dist).xyz;
+    ShadowMap m = shadow_map(i, x, 0.0);
+    vec3 s = shadow_point(m, frame.light_vec[i].w > 0.5, x, ng, l, dist).xyz;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
     vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
     float lit = 0.0;

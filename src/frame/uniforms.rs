@@ -54,6 +54,13 @@ pub struct FrameUniforms {
     /// specular lobe's m² (light::shadow::lobe_widening); w: a point light's
     /// shadow near plane, mm (its depth is perspective), else 0.
     pub light_params: [[f32; 4]; MAX_LIGHTS],
+    /// World to (atlas u, v, depth) in the light's focus tile (the window of
+    /// its map that holds what the camera sees, light::shadow::Focus).
+    pub light_focus: [[[f32; 4]; 4]; MAX_LIGHTS],
+    /// x: the focus tile's texel, mm (0: no focus map); y: the depth of the
+    /// nearest surface it holds (light::shadow::Focus::nearest); z, w: the
+    /// tile's lowest atlas corner (u, v).
+    pub light_focus_tile: [[f32; 4]; MAX_LIGHTS],
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],

@@ -10,12 +10,113 @@ use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use crate::scene::LightSource;
 use ash::vk;
 use glam::camera::rh::{proj::vulkan as proj, view::look_at_mat4};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
 /// Each light's frustum holds the mesh's bounding sphere grown by this factor, so
 /// PCF taps at the rim stay inside the light's tile.
 const FIT_MARGIN: f32 = 1.05;
+
+/// A focus map is drawn only when it is at least this much finer than the
+/// whole map: a second tile that gains less is not worth its draw.
+const MIN_FOCUS_ZOOM: f32 = 1.5;
+
+/// A shadowed light's two maps, in two neighbouring tiles of the atlas.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowMaps {
+    /// Holds the mesh's bounding sphere, so every texel of the irradiance
+    /// texture finds its shadow.
+    pub whole: ShadowView,
+    /// The window of `whole` that holds what the camera sees, at the same
+    /// resolution: finer where the face is (`None`: it would not be
+    /// [`MIN_FOCUS_ZOOM`]× finer). The shaders use it wherever a lookup and its
+    /// filter fit inside it (common/lights.glsl, `shadow_map`).
+    pub focus: Option<Focus>,
+}
+
+/// A square window of a whole map, in its normalised device coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Focus {
+    pub view: ShadowView,
+    pub centre: Vec2,
+    /// Half the side (1: the whole map).
+    pub half: f32,
+    /// The depth of the nearest vertex in the window: no blocker of its soft
+    /// shadows lies nearer the light, which bounds their blocker search.
+    pub nearest: f32,
+}
+
+impl Focus {
+    /// The window of `whole` (a `resolution`² map) around the `seen` points
+    /// the camera sees, each grown by `margin_mm` (the diffusion's reach: light
+    /// from just outside the view scatters into it), over the mesh of
+    /// `vertices`; `None` when nothing is seen or the window would not be
+    /// [`MIN_FOCUS_ZOOM`]× finer.
+    pub fn fit(
+        whole: &ShadowView,
+        seen: &[Vec3],
+        vertices: &[Vec3],
+        margin_mm: f32,
+        resolution: u32,
+    ) -> Option<Self> {
+        let ndc = |p: &Vec3| whole.view_proj.project_point3(*p);
+        let lo = seen.iter().map(|p| ndc(p).truncate()).reduce(Vec2::min)?;
+        let hi = seen.iter().map(|p| ndc(p).truncate()).reduce(Vec2::max)?;
+        // Normalised coordinates per mm: a point light's at its nearest, where
+        // a mm spans the most.
+        let span_mm = resolution as f32 * whole.texel_mm * whole.near_mm.unwrap_or(1.0);
+        let margin = Vec2::splat(2.0 * margin_mm / span_mm);
+        let (lo, hi) = ((lo - margin).max(Vec2::NEG_ONE), (hi + margin).min(Vec2::ONE));
+        let half = 0.5 * (hi - lo).max_element();
+        if half * MIN_FOCUS_ZOOM > 1.0 {
+            return None;
+        }
+        // The square inside the map.
+        let centre = (0.5 * (lo + hi)).clamp(Vec2::splat(half - 1.0), Vec2::splat(1.0 - half));
+        // Vertices a margin beyond the window too, for triangles that cross
+        // its border.
+        let reach = Vec2::splat(half) + margin;
+        let nearest = vertices
+            .iter()
+            .map(ndc)
+            .filter(|p| (p.truncate() - centre).abs().cmple(reach).all())
+            .map(|p| p.z)
+            .fold(1.0, f32::min)
+            .max(0.0);
+        Some(Self::window(whole, centre, half, nearest))
+    }
+
+    /// The window (`centre`, `half`) of `whole`: its clip space scaled by
+    /// 1/half about the centre, depth and w unchanged (so depth range, near
+    /// plane and what the shaders derive from them stay the whole map's).
+    fn window(whole: &ShadowView, centre: Vec2, half: f32, nearest: f32) -> Self {
+        let k = 1.0 / half;
+        let zoom = Mat4::from_cols(
+            Vec4::new(k, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, k, 0.0, 0.0),
+            Vec4::Z,
+            Vec4::new(-k * centre.x, -k * centre.y, 0.0, 1.0),
+        );
+        Self {
+            view: ShadowView {
+                view_proj: zoom * whole.view_proj,
+                texel_mm: whole.texel_mm * half,
+                ..*whole
+            },
+            centre,
+            half,
+            nearest,
+        }
+    }
+
+    /// Whether this window can stay for a camera that now needs `new`: it
+    /// holds `new` and is at most twice its size, so small camera moves (the
+    /// viewer's) do not draw the maps again.
+    pub fn holds(&self, new: &Focus) -> bool {
+        let reach = Vec2::splat(self.half - new.half);
+        (new.centre - self.centre).abs().cmple(reach).all() && new.half * 2.0 >= self.half
+    }
+}
 
 /// One light's shadow projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,13 +234,9 @@ impl ShadowView {
     }
 }
 
-/// The shadowed lights' projections, in tile order.
-fn tile_matrices(views: &[Option<ShadowView>]) -> Vec<[f32; 16]> {
-    views
-        .iter()
-        .flatten()
-        .map(|v| v.view_proj.to_cols_array())
-        .collect()
+/// The projections of the atlas's tiles, in order (`None`: a tile left empty).
+fn tile_matrices(tiles: &[Option<ShadowView>]) -> Vec<Option<[f32; 16]>> {
+    tiles.iter().map(|v| v.map(|v| v.view_proj.to_cols_array())).collect()
 }
 
 /// Renders the atlas: depth only, no culling (scanned meshes are not closed).
@@ -148,18 +245,18 @@ fn tile_matrices(views: &[Option<ShadowView>]) -> Vec<[f32; 16]> {
 pub struct ShadowPass {
     pipeline: Arc<Pipeline>,
     atlas: Arc<Image>,
-    /// The shadowed lights' projections, in tile order.
-    matrices: Vec<[f32; 16]>,
+    /// The shadowed lights' projections, in tile order (`None`: not drawn).
+    matrices: Vec<Option<[f32; 16]>>,
     resolution: u32,
 }
 
 impl ShadowPass {
-    /// The pass and atlas of the lights' `views` (`None`: unshadowed; the
-    /// shadowed ones take tiles in order), `resolution` texels a side; a 1×1
-    /// atlas when there are none, so the lighting shaders always have one to bind.
+    /// The pass and atlas of `tiles` (light::lighting::Lighting::tiles;
+    /// `None`: left empty), `resolution` texels a side; a 1×1 atlas when there
+    /// are none, so the lighting shaders always have one to bind.
     pub fn new(
         pipelines: &Pipelines,
-        views: &[Option<ShadowView>],
+        tiles: &[Option<ShadowView>],
         resolution: u32,
     ) -> Result<Self> {
         let ctx = pipelines.ctx();
@@ -175,7 +272,7 @@ impl ShadowPass {
             specialization: &[],
             alpha_blend: false,
         })?;
-        let matrices = tile_matrices(views);
+        let matrices = tile_matrices(tiles);
         let (cols, rows) = atlas_grid(matrices.len());
         let (w, h) = match matrices.len() {
             0 => (1, 1),
@@ -195,10 +292,10 @@ impl ShadowPass {
         })
     }
 
-    /// The same lights turned (the environment's sources): new projections, as
-    /// many tiles.
-    pub fn set_views(&mut self, views: &[Option<ShadowView>]) {
-        let matrices = tile_matrices(views);
+    /// The same lights turned (the environment's sources) or seen from
+    /// elsewhere (the focus): new projections, as many tiles.
+    pub fn set_tiles(&mut self, tiles: &[Option<ShadowView>]) {
+        let matrices = tile_matrices(tiles);
         debug_assert_eq!(matrices.len(), self.matrices.len(), "the atlas's tiles");
         self.matrices = matrices;
     }
@@ -221,6 +318,7 @@ impl ShadowPass {
                 .depth(&mut atlas, LoadOp::Clear([1.0; 4]))
                 .record(move |cx| {
                     for (i, m) in matrices.iter().enumerate() {
+                        let Some(m) = m else { continue };
                         let (col, row) = (i as u32 % cols, i as u32 / cols);
                         cx.set_viewport(col * resolution, row * resolution, resolution, resolution);
                         cx.push_constants(&pipe, m);
@@ -335,5 +433,66 @@ mod tests {
         let t = 5f32.to_radians().tan();
         assert!((lobe_widening(10f32.to_radians()) - 0.5 * t * t).abs() < 1e-7);
         assert_eq!(lobe_widening(0.0), 0.0);
+    }
+
+    /// A patch the camera sees, 40 mm across, in a mesh 200 mm in radius: its
+    /// window lands it inside the focus tile at a finer texel, with the whole
+    /// map's depths, and its nearest vertex bounds every depth in the window.
+    #[test]
+    fn the_focus_window_holds_what_the_camera_sees_finer() {
+        let (c, r) = (Vec3::ZERO, 200.0);
+        let patch: Vec<Vec3> = (0..25)
+            .map(|k| Vec3::new((k % 5) as f32 * 10.0 - 20.0, (k / 5) as f32 * 10.0, 60.0))
+            .collect();
+        let blocker = Vec3::new(0.0, 20.0, 120.0);
+        let far = Vec3::new(150.0, -100.0, 100.0);
+        let vertices: Vec<Vec3> = patch.iter().copied().chain([blocker, far]).collect();
+        for light in [
+            LightSource::Directional(Vec3::new(0.2, 0.3, 1.0).normalize()),
+            LightSource::Point(Vec3::new(100.0, 200.0, 900.0)),
+        ] {
+            let whole = ShadowView::fit(light, c, r, 1024).unwrap();
+            let f = Focus::fit(&whole, &patch, &vertices, 5.0, 1024).unwrap();
+            assert!(f.half < 0.25, "{light:?}: {}", f.half);
+            assert!((f.view.texel_mm - whole.texel_mm * f.half).abs() < 1e-6);
+            let (m, m_whole) = (f.view.atlas_matrix(1, 2), whole.atlas_matrix(0, 2));
+            for p in &patch {
+                let (s, s_whole) = (m.project_point3(*p), m_whole.project_point3(*p));
+                assert!(s.x > 0.5 && s.x < 1.0 && s.y > 0.0 && s.y < 1.0, "{light:?}: {s}");
+                assert!((s.z - s_whole.z).abs() < 1e-6, "{light:?}: depth");
+                assert!(f.nearest <= s.z);
+            }
+            // The blocker between the patch and the light is the nearest; the
+            // far vertex outside the window does not count.
+            let blocker_depth = m.project_point3(blocker).z;
+            assert!((f.nearest - blocker_depth).abs() < 1e-6, "{light:?}: {}", f.nearest);
+            assert!(m.project_point3(far).x > 1.0 || m.project_point3(far).y < 0.0);
+        }
+    }
+
+    #[test]
+    fn no_focus_where_the_camera_sees_nearly_everything_or_nothing() {
+        let (c, r) = (Vec3::ZERO, 100.0);
+        let whole = ShadowView::fit(LightSource::Directional(Vec3::Z), c, r, 512).unwrap();
+        let rim = [Vec3::new(-90.0, -90.0, 0.0), Vec3::new(90.0, 90.0, 0.0)];
+        assert!(Focus::fit(&whole, &rim, &rim, 0.0, 512).is_none());
+        assert!(Focus::fit(&whole, &[], &rim, 0.0, 512).is_none());
+        // A patch a third of the map across is 1.5× finer or more.
+        let third = [Vec3::new(-30.0, -30.0, 0.0), Vec3::new(30.0, 30.0, 0.0)];
+        assert!(Focus::fit(&whole, &third, &third, 0.0, 512).is_some());
+    }
+
+    /// Small camera moves keep the window (no new maps); leaving it or
+    /// zooming in past half its size does not.
+    #[test]
+    fn a_window_stays_while_it_holds_the_view() {
+        let whole = ShadowView::fit(LightSource::Directional(Vec3::Z), Vec3::ZERO, 100.0, 512)
+            .unwrap();
+        let at = |x: f32, half: f32| Focus::window(&whole, Vec2::new(x, 0.0), half, 0.0);
+        let old = at(0.0, 0.4);
+        assert!(old.holds(&at(0.05, 0.3)));
+        assert!(!old.holds(&at(0.2, 0.3)), "leaves the window");
+        assert!(!old.holds(&at(0.0, 0.15)), "over twice too large");
+        assert!(!old.holds(&at(0.0, 0.5)), "larger");
     }
 }

@@ -118,6 +118,7 @@ mod tests {
             height: 9,
             irradiance_resolution: 512,
             shadow_resolution: 256,
+            shadow_focus: false,
             exposure: Some(1.5),
             gamma: Gamma::Power(1.8),
             tone_curve: ToneCurve::Aces,
@@ -140,6 +141,7 @@ mod tests {
             (cleared.irradiance_resolution, cleared.shadow_resolution),
             (r.irradiance_resolution, r.shadow_resolution)
         );
+        assert_eq!(cleared.shadow_focus, r.shadow_focus);
         assert_ne!(
             (d.width, d.irradiance_resolution, d.shadow_resolution),
             (r.width, r.irradiance_resolution, r.shadow_resolution)

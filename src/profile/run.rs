@@ -54,6 +54,9 @@ pub struct RunSetup {
     /// Occlusion method: `raster`, `raytrace` or `off`.
     pub occlusion: String,
     pub shadow_resolution: u32,
+    /// A second shadow map per shadowed light, fitted to what the camera sees
+    /// (`render.shadow_focus`; false in reports written before it existed).
+    pub shadow_focus: bool,
     /// The scene's explicit lights.
     pub lights: usize,
     /// `environment.lights`: `auto` or a count.

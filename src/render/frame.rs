@@ -19,7 +19,7 @@ use crate::light::extract::extract;
 use crate::light::lighting::Lighting;
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
-use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass};
+use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
 use crate::light::skybox;
 use crate::light::visibility::{VisibilityPass, TEXTURES};
 use crate::post::debug::{DebugPass, DepthRange};
@@ -63,7 +63,7 @@ fn frame_uniforms(
     specular_scale: f32,
 ) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
-    let tiles = lighting.views.iter().flatten().count();
+    let tiles = lighting.tiles().len();
     let mut u = FrameUniforms {
         view_proj: vp.to_cols_array_2d(),
         inv_view_proj: vp.inverse().to_cols_array_2d(),
@@ -72,6 +72,8 @@ fn frame_uniforms(
         light_color: [[0.0; 4]; MAX_LIGHTS],
         light_shadow: [[[0.0; 4]; 4]; MAX_LIGHTS],
         light_params: [[0.0; 4]; MAX_LIGHTS],
+        light_focus: [[[0.0; 4]; 4]; MAX_LIGHTS],
+        light_focus_tile: [[0.0; 4]; MAX_LIGHTS],
         env: [
             lighting.rotation_deg.to_radians(),
             lighting.intensity,
@@ -85,8 +87,9 @@ fn frame_uniforms(
             atlas_grid(tiles).1 as f32,
         ],
     };
+    let (cols, rows) = atlas_grid(tiles);
     let mut tile = 0;
-    for (i, (l, view)) in lighting.lights.iter().zip(&lighting.views).enumerate() {
+    for (i, (l, maps)) in lighting.lights.iter().zip(&lighting.maps).enumerate() {
         u.light_vec[i] = match l.source {
             LightSource::Directional(d) => d.extend(0.0),
             LightSource::Point(p) => p.extend(1.0),
@@ -95,12 +98,18 @@ fn frame_uniforms(
         u.light_color[i] = l.irradiance.extend(0.0).into();
         u.light_params[i][0] = l.angular_radius.tan();
         u.light_params[i][2] = lobe_widening(l.angular_radius);
-        if let Some(v) = view {
-            u.light_color[i][3] = v.texel_mm;
-            u.light_shadow[i] = v.atlas_matrix(tile, tiles).to_cols_array_2d();
-            u.light_params[i][1] = v.depth_range_mm;
-            u.light_params[i][3] = v.near_mm.unwrap_or(0.0);
-            tile += 1;
+        if let Some(m) = maps {
+            u.light_color[i][3] = m.whole.texel_mm;
+            u.light_shadow[i] = m.whole.atlas_matrix(tile, tiles).to_cols_array_2d();
+            u.light_params[i][1] = m.whole.depth_range_mm;
+            u.light_params[i][3] = m.whole.near_mm.unwrap_or(0.0);
+            if let Some(f) = m.focus {
+                let t = tile as u32 + 1;
+                u.light_focus[i] = f.view.atlas_matrix(t as usize, tiles).to_cols_array_2d();
+                let corner = [(t % cols) as f32 / cols as f32, (t / cols) as f32 / rows as f32];
+                u.light_focus_tile[i] = [f.view.texel_mm, f.nearest, corner[0], corner[1]];
+            }
+            tile += lighting.tiles_per_light();
         }
         u.env[2] = (i + 1) as f32;
     }
@@ -118,7 +127,7 @@ fn frame_inputs(
 ) -> Result<FrameInputs> {
     let samplers = Arc::new(Samplers::new(ctx)?);
     let env = upload_env(ctx, &scene.env)?;
-    let (lights, views) = (&lighting.lights, &lighting.views);
+    let (lights, views) = (&lighting.lights, &lighting.maps);
     // Bit i set where light i has `has`.
     let bits = |has: &dyn Fn(usize) -> bool| {
         (0..lights.len())
@@ -212,7 +221,7 @@ impl Passes {
             irradiance: IrradiancePass::new(p, variant)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(p, variant, skin.transmission > 0.0)?,
-            shadow: ShadowPass::new(p, &lighting.views, lighting.shadow_resolution)?,
+            shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,
             prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
             debug: DebugPass::new(p, &scene.regions)?,
@@ -276,13 +285,33 @@ impl Frame {
             );
         }
         let residual = (!extraction.lights.is_empty()).then_some(&extraction.residual);
-        let lighting = Lighting::resolve(scene, extraction.lights.clone());
-        let tiles = lighting.views.iter().flatten().count();
+        // The focus maps hold the light that scatters into the view: four σ
+        // of the profile's widest Gaussian beyond it.
+        let widest = skin.profile.gaussians.last().map_or(0.0, |g| g.variance_mm2);
+        let margin_mm = 4.0 * widest.sqrt();
+        let lighting = Lighting::resolve(scene, extraction.lights.clone(), margin_mm);
+        for (i, m) in lighting.maps.iter().enumerate() {
+            let Some(m) = m else { continue };
+            let texel = |v: &ShadowView| v.texel_mm * v.near_mm.unwrap_or(1.0);
+            match m.focus {
+                Some(f) => log::info!(
+                    "light {i}: shadow map {:.3} mm a texel where the camera looks \
+                     ({:.1}× finer), {:.3} mm elsewhere",
+                    texel(&f.view),
+                    1.0 / f.half,
+                    texel(&m.whole)
+                ),
+                None => log::info!("light {i}: shadow map {:.3} mm a texel", texel(&m.whole)),
+            }
+        }
+        let tiles = lighting.tiles().len();
         let (cols, rows) = atlas_grid(tiles);
         let res = lighting.shadow_resolution;
         super::check_target(&ctx.info, res * cols, res * rows).map_err(|e| {
             Error::Input(format!(
-                "shadow atlas of {tiles} light(s) at render.shadow_resolution = {res}: {e}"
+                "shadow atlas of {tiles} tile(s) ({} per shadowed light) at \
+                 render.shadow_resolution = {res}: {e}",
+                lighting.tiles_per_light()
             ))
         })?;
         let m = &scene.mesh;
@@ -337,9 +366,14 @@ impl Frame {
     }
 
     /// Moves the camera to `scene.camera` at the aspect of `scene.file.render`'s
-    /// size: the frame's uniforms and the depth view's range are made again.
+    /// size: the frame's uniforms and the depth view's range are made again,
+    /// and the shadow focus maps where the camera left them (kept by key, they
+    /// are drawn again by the next frame that needs them).
     pub(super) fn set_camera(&mut self, ctx: &Arc<Context>, scene: &Scene) -> Result<()> {
         self.depth_range = depth_range(scene);
+        if self.lighting.set_camera(scene) {
+            self.passes.shadow.set_tiles(&self.lighting.tiles());
+        }
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let aspect = w as f32 / h as f32;
         let uniforms = frame_uniforms(scene, &self.lighting, aspect, self.specular_scale);
@@ -361,7 +395,7 @@ impl Frame {
         self.lighting.turn(env.rotation_deg);
         self.sh_buffers
             .set_transform(ctx, env.rotation_deg, env.intensity)?;
-        self.passes.shadow.set_views(&self.lighting.views);
+        self.passes.shadow.set_tiles(&self.lighting.tiles());
         self.set_camera(ctx, scene)
     }
 

@@ -123,6 +123,7 @@ fn setup(
         }
         .into(),
         shadow_resolution: f.render.shadow_resolution,
+        shadow_focus: f.render.shadow_focus,
         lights: f.lights.len(),
         environment_lights: f.environment.lights.to_string(),
         extracted_lights,

@@ -161,6 +161,10 @@ overrides! {
     /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     test_texture: bool => textures.test_texture, example "on";
+    /// A second shadow map per shadowed light, fitted to what the camera sees
+    /// (finer where the face is), replacing `render.shadow_focus`.
+    #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
+    shadow_focus: bool => render.shadow_focus, example "off";
     /// Side of the UV-space irradiance texture (power of two, 256..8192).
     irradiance_res: u32 => render.irradiance_resolution, example "512";
     /// Per-vertex occlusion (default: the scene's, raytrace).

@@ -68,6 +68,9 @@ pub struct Render {
     pub irradiance_resolution: u32,
     /// Side of each light's shadow map (power of two, 256..=8192).
     pub shadow_resolution: u32,
+    /// A second map per shadowed light, fitted to what the camera sees
+    /// (light::shadow::Focus).
+    pub shadow_focus: bool,
     /// Exposure in EV (stops): output = radiance × 2^exposure. `None`: metered
     /// from the rendered frame (post::meter).
     pub exposure: Option<f32>,
@@ -92,6 +95,7 @@ impl Default for Render {
             height: 720,
             irradiance_resolution: 4096,
             shadow_resolution: 2048,
+            shadow_focus: true,
             exposure: None,
             gamma: Gamma::Srgb,
             tone_curve: ToneCurve::Linear,
