@@ -76,27 +76,16 @@ impl Lighting {
         self.maps = self.shadow_maps();
     }
 
-    /// The camera moved: the vertices it sees again, and the focus maps where
-    /// they no longer hold them or have become more than twice too large
-    /// ([`Focus::holds`]). True when a projection changed.
+    /// The camera moved: the vertices it sees again, and the focus maps that
+    /// changed with them (Focus::fit snaps windows, so a small move changes
+    /// none). True when a projection changed.
     pub fn set_camera(&mut self, scene: &Scene) -> bool {
         if !self.focus {
             return false;
         }
         self.seen = seen_vertices(scene);
-        let mut maps = std::mem::take(&mut self.maps);
-        let mut changed = false;
-        for m in maps.iter_mut().flatten() {
-            let new = self.focus_of(&m.whole);
-            let keep = match (m.focus, new) {
-                (Some(old), Some(new)) => old.holds(&new),
-                (old, new) => old == new,
-            };
-            if !keep {
-                m.focus = new;
-                changed = true;
-            }
-        }
+        let maps = self.shadow_maps();
+        let changed = maps != self.maps;
         self.maps = maps;
         changed
     }
