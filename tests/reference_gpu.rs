@@ -248,7 +248,11 @@ fn nose_shadow_edge_against_the_reference() {
         results.extend(rows);
     }
     for [diameter, focus, offset, penumbra, penumbra_ref] in &results {
-        let map = if *focus > 0.5 { "with its focus map" } else { "whole mesh only" };
+        let map = if *focus > 0.5 {
+            "with its focus map"
+        } else {
+            "whole mesh only"
+        };
         println!(
             "light {diameter}°, 2048² shadow map, {map}: edge {offset:+.2} mm into the \
              reference's shadow, penumbra {penumbra:.2} mm (reference {penumbra_ref:.2} mm)"
@@ -266,7 +270,10 @@ fn nose_shadow_edge_against_the_reference() {
     // reference's (measured: 1.52 mm); the hard light's, a pixel or two in the
     // reference, at most twice it.
     assert!(results[2][4] > results[0][4] + 0.5, "{results:?}");
-    assert!((results[3][3] / results[3][4] - 1.0).abs() <= 0.25, "{results:?}");
+    assert!(
+        (results[3][3] / results[3][4] - 1.0).abs() <= 0.25,
+        "{results:?}"
+    );
     assert!(results[1][3] <= 2.0 * results[1][4], "{results:?}");
 }
 

@@ -8,8 +8,8 @@
 use super::extract::ExtractedLight;
 use super::shadow::{Focus, ShadowMaps, ShadowView};
 use crate::frame::MAX_LIGHTS;
-use crate::scene::file::Occlusion;
 use crate::scene::camera::Camera;
+use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
 use crate::scene::{Light, LightSource, Scene};
 use glam::Vec3;
@@ -122,7 +122,10 @@ impl Lighting {
             let (LightSource::Directional(p) | LightSource::Point(p)) = l.source;
             values.extend(p.to_array());
             values.push(l.angular_radius);
-            for v in m.iter().flat_map(|m| [Some(m.whole), m.focus.map(|f| f.view)]) {
+            for v in m
+                .iter()
+                .flat_map(|m| [Some(m.whole), m.focus.map(|f| f.view)])
+            {
                 values.extend(v.map_or([0.0; 16], |v| v.view_proj.to_cols_array()));
             }
         }
@@ -158,7 +161,13 @@ impl Lighting {
     /// The focus window of a light's `whole` map: where the camera looks.
     fn focus_of(&self, whole: &ShadowView) -> Option<Focus> {
         let (seen, vertices) = (&self.seen, &self.vertices);
-        Focus::fit(whole, seen, vertices, self.margin_mm, self.shadow_resolution)
+        Focus::fit(
+            whole,
+            seen,
+            vertices,
+            self.margin_mm,
+            self.shadow_resolution,
+        )
     }
 
     /// The shadow projections of each light (`None`: unshadowed).

@@ -66,7 +66,10 @@ impl Focus {
         // a mm spans the most.
         let span_mm = resolution as f32 * whole.texel_mm * whole.near_mm.unwrap_or(1.0);
         let margin = Vec2::splat(2.0 * margin_mm / span_mm);
-        let (lo, hi) = ((lo - margin).max(Vec2::NEG_ONE), (hi + margin).min(Vec2::ONE));
+        let (lo, hi) = (
+            (lo - margin).max(Vec2::NEG_ONE),
+            (hi + margin).min(Vec2::ONE),
+        );
         // Snapped, so that a small camera move gives the same window (the maps
         // are not drawn again) while one camera always gives one window: the
         // side up to a step of 2^(1/8), the centre to 1/16 of it, which moves
@@ -115,7 +118,6 @@ impl Focus {
             nearest,
         }
     }
-
 }
 
 /// One light's shadow projection.
@@ -236,7 +238,10 @@ impl ShadowView {
 
 /// The projections of the atlas's tiles, in order (`None`: a tile left empty).
 fn tile_matrices(tiles: &[Option<ShadowView>]) -> Vec<Option<[f32; 16]>> {
-    tiles.iter().map(|v| v.map(|v| v.view_proj.to_cols_array())).collect()
+    tiles
+        .iter()
+        .map(|v| v.map(|v| v.view_proj.to_cols_array()))
+        .collect()
 }
 
 /// Renders the atlas: depth only, no culling (scanned meshes are not closed).
@@ -458,14 +463,21 @@ mod tests {
             let (m, m_whole) = (f.view.atlas_matrix(1, 2), whole.atlas_matrix(0, 2));
             for p in &patch {
                 let (s, s_whole) = (m.project_point3(*p), m_whole.project_point3(*p));
-                assert!(s.x > 0.5 && s.x < 1.0 && s.y > 0.0 && s.y < 1.0, "{light:?}: {s}");
+                assert!(
+                    s.x > 0.5 && s.x < 1.0 && s.y > 0.0 && s.y < 1.0,
+                    "{light:?}: {s}"
+                );
                 assert!((s.z - s_whole.z).abs() < 1e-6, "{light:?}: depth");
                 assert!(f.nearest <= s.z);
             }
             // The blocker between the patch and the light is the nearest; the
             // far vertex outside the window does not count.
             let blocker_depth = m.project_point3(blocker).z;
-            assert!((f.nearest - blocker_depth).abs() < 1e-6, "{light:?}: {}", f.nearest);
+            assert!(
+                (f.nearest - blocker_depth).abs() < 1e-6,
+                "{light:?}: {}",
+                f.nearest
+            );
             assert!(m.project_point3(far).x > 1.0 || m.project_point3(far).y < 0.0);
         }
     }
@@ -486,8 +498,8 @@ mod tests {
     /// zooming in does not.
     #[test]
     fn a_window_stays_while_the_view_moves_a_little() {
-        let whole = ShadowView::fit(LightSource::Directional(Vec3::Z), Vec3::ZERO, 100.0, 512)
-            .unwrap();
+        let whole =
+            ShadowView::fit(LightSource::Directional(Vec3::Z), Vec3::ZERO, 100.0, 512).unwrap();
         let at = |x: f32, size: f32| {
             let patch = [Vec3::new(x, 0.0, 0.0), Vec3::new(x + size, size, 0.0)];
             Focus::fit(&whole, &patch, &patch, 0.0, 512).unwrap()
@@ -501,6 +513,9 @@ mod tests {
         // 2^(1/8): 15 mm of the map's 100 · FIT_MARGIN mm, half a side each.
         let half_mm = f.half * 100.0 * FIT_MARGIN;
         let least = 15.0 * 17.0 / 16.0;
-        assert!(half_mm >= least && half_mm <= least * 2f32.powf(0.125), "{half_mm}");
+        assert!(
+            half_mm >= least && half_mm <= least * 2f32.powf(0.125),
+            "{half_mm}"
+        );
     }
 }

@@ -106,7 +106,10 @@ fn frame_uniforms(
             if let Some(f) = m.focus {
                 let t = tile as u32 + 1;
                 u.light_focus[i] = f.view.atlas_matrix(t as usize, tiles).to_cols_array_2d();
-                let corner = [(t % cols) as f32 / cols as f32, (t / cols) as f32 / rows as f32];
+                let corner = [
+                    (t % cols) as f32 / cols as f32,
+                    (t / cols) as f32 / rows as f32,
+                ];
                 u.light_focus_tile[i] = [f.view.texel_mm, f.nearest, corner[0], corner[1]];
             }
             tile += lighting.tiles_per_light();
@@ -287,7 +290,11 @@ impl Frame {
         let residual = (!extraction.lights.is_empty()).then_some(&extraction.residual);
         // The focus maps hold the light that scatters into the view: four σ
         // of the profile's widest Gaussian beyond it.
-        let widest = skin.profile.gaussians.last().map_or(0.0, |g| g.variance_mm2);
+        let widest = skin
+            .profile
+            .gaussians
+            .last()
+            .map_or(0.0, |g| g.variance_mm2);
         let margin_mm = 4.0 * widest.sqrt();
         let lighting = Lighting::resolve(scene, extraction.lights.clone(), margin_mm);
         for (i, m) in lighting.maps.iter().enumerate() {
