@@ -118,16 +118,13 @@ impl Lighting {
     /// the lights and their projections.
     pub fn shadow_key(&self) -> u64 {
         let mut values = Vec::new();
-        for (l, m) in self.lights.iter().zip(&self.maps) {
+        for l in &self.lights {
             let (LightSource::Directional(p) | LightSource::Point(p)) = l.source;
             values.extend(p.to_array());
             values.push(l.angular_radius);
-            for v in m
-                .iter()
-                .flat_map(|m| [Some(m.whole), m.focus.map(|f| f.view)])
-            {
-                values.extend(v.map_or([0.0; 16], |v| v.view_proj.to_cols_array()));
-            }
+        }
+        for v in self.tiles() {
+            values.extend(v.map_or([0.0; 16], |v| v.view_proj.to_cols_array()));
         }
         key(&values)
     }
@@ -209,6 +206,7 @@ fn seen_vertices(scene: &Scene) -> Vec<Vec3> {
     seen_by(&scene.camera, r.width as f32 / r.height as f32, &scene.mesh)
 }
 
+/// The vertices of `mesh` that `camera` sees at `aspect`.
 fn seen_by(camera: &Camera, aspect: f32, mesh: &Mesh) -> Vec<Vec3> {
     let vp = camera.view_projection(aspect);
     mesh.positions
