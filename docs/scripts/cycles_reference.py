@@ -17,6 +17,7 @@ Position (world, Blender units, Z up), written to a temporary file and renamed.
 """
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -55,7 +56,9 @@ CAMERA_FOV_Y_DEG = 30.0
 
 def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--out", required=True, help="output .exr (multilayer)")
+    p.add_argument(
+        "--out", required=True, help="output .exr (multilayer); .json with --calibrate"
+    )
     p.add_argument(
         "--env",
         default="uniform",
@@ -88,14 +91,34 @@ def parse_args(argv):
         "linear albedo (no maps; specular at the map's mean), seen from above",
     )
     p.add_argument(
+        "--skybox",
+        action="store_true",
+        help="show the environment behind the head (alpha 1 there: only to check "
+        "the map's orientation against dermis's --skybox on)",
+    )
+    p.add_argument(
+        "--calibrate",
+        action="store_true",
+        help="render the slab (no specular) at base colours 0.02 ... 1 and write "
+        "its total reflectance under the uniform sky to --out (.json)",
+    )
+    p.add_argument(
+        "--albedo-table",
+        metavar="FILE.json",
+        help="a --calibrate table: give the random walk the base colour whose "
+        "slab reflects the albedo map's value (dermis's meaning of albedo)",
+    )
+    p.add_argument(
         "--view",
         choices=["final", "albedo"],
         default="final",
         help="albedo: the albedo map as emission (to check the UVs)",
     )
     args = p.parse_args(argv)
-    if not args.out.lower().endswith(".exr"):
-        p.error("--out must end in .exr")
+    if not args.out.lower().endswith(".json" if args.calibrate else ".exr"):
+        p.error("--out must end in .json with --calibrate, else .exr")
+    if args.albedo_table is not None:
+        args.albedo_table = read_table(p, args.albedo_table)
     out_dir = os.path.dirname(os.path.abspath(args.out))
     if not os.path.isdir(out_dir):
         p.error(f"--out: no folder {out_dir}")
@@ -114,6 +137,19 @@ def parse_args(argv):
     if args.bounces < 0 or args.seed < 0:
         p.error("--bounces and --seed must be >= 0")
     return args
+
+
+def read_table(p, path):
+    """A --calibrate table as (reflectance, base) pairs, checked monotone."""
+    try:
+        with open(path) as f:
+            t = json.load(f)
+        pairs = list(zip(t["reflectance"], t["base"]))
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        p.error(f"--albedo-table {path}: {e}")
+    if len(pairs) < 2 or any(b[0] <= a[0] or b[1] <= a[1] for a, b in zip(pairs, pairs[1:])):
+        p.error(f"--albedo-table {path}: needs two or more increasing pairs")
+    return pairs
 
 
 def to_blender(v_mm):
@@ -161,6 +197,21 @@ def skin_material(args):
         links.new(albedo.outputs["Color"], emit.inputs["Color"])
         links.new(emit.outputs["Emission"], out.inputs["Surface"])
         return mat
+
+    if args.albedo_table:
+        # Reflectance -> base colour, the inverse of the slab's curve (Cycles
+        # tabulates the curve; the points are interpolated smoothly).
+        curves = nodes.new("ShaderNodeRGBCurve")
+        curve = curves.mapping.curves[3]  # C: every channel
+        (r0, b0), rest = args.albedo_table[0], args.albedo_table[1:]
+        curve.points[0].location = (0.0, 0.0)
+        curve.points[1].location = (r0, b0)
+        for r, b in rest:
+            curve.points.new(r, b)
+        curves.mapping.use_clip = False
+        curves.mapping.update()
+        links.new(albedo.outputs["Color"], curves.inputs["Color"])
+        albedo = curves
 
     bsdf = nodes.new("ShaderNodeBsdfPrincipled")
     bsdf.distribution = "MULTI_GGX"
@@ -289,6 +340,8 @@ def main():
     args = parse_args(argv)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
+    if args.calibrate:
+        args.slab, args.specular, args.sss, args.albedo_table = (0.5, 0.5, 0.5), "off", "on", None
     head = slab() if args.slab else import_head()
     head.data.materials.clear()
     head.data.materials.append(skin_material(args))
@@ -320,7 +373,7 @@ def main():
     scene.render.resolution_x = args.width
     scene.render.resolution_y = args.height
     scene.render.resolution_percentage = 100
-    scene.render.film_transparent = True
+    scene.render.film_transparent = not args.skybox
     scene.view_settings.view_transform = "Standard"
     scene.view_settings.look = "None"
     scene.view_settings.exposure = 0.0
@@ -338,12 +391,46 @@ def main():
     scene.render.filepath = tmp
     scene.render.use_file_extension = False
     try:
-        bpy.ops.render.render(write_still=True)
-        os.replace(tmp, out)
+        if args.calibrate:
+            calibrate(args, head.data.materials[0], tmp, out)
+        else:
+            bpy.ops.render.render(write_still=True)
+            os.replace(tmp, out)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
     print(f"wrote {out}", flush=True)
+
+
+def calibrate(args, material, tmp, out):
+    """The slab's total reflectance under the uniform sky (its radiance seen
+    from above) for base colours 0.02 ... 1, three per render."""
+    import numpy as np
+    import OpenEXR
+
+    colour = next(n for n in material.node_tree.nodes if n.type == "RGB")
+    base = [0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0]
+    reflectance, stderr = [], []
+    for i in range(0, len(base), 3):
+        colour.outputs["Color"].default_value = tuple(base[i : i + 3]) + (1.0,)
+        bpy.ops.render.render(write_still=True)
+        px = OpenEXR.File(tmp).parts[0].channels["ViewLayer.Combined"].pixels
+        rgb = px[..., :3].reshape(-1, 3).astype(np.float64)
+        reflectance += list(rgb.mean(0))
+        stderr += list(rgb.std(0) / np.sqrt(len(rgb)))
+    table = {
+        "what": "Cycles random walk (spec off) on a slab under a uniform sky of 1",
+        "blender": bpy.app.version_string,
+        "samples": args.samples,
+        "pixels": args.width * args.height,
+        "base": base,
+        "reflectance": [round(r, 5) for r in reflectance],
+        "stderr": [round(e, 5) for e in stderr],
+    }
+    part = out + ".tmp"
+    with open(part, "w") as f:
+        json.dump(table, f, indent=1)
+    os.replace(part, out)
 
 
 if __name__ == "__main__":
