@@ -93,8 +93,10 @@ def extra_groups(d):
 
 
 def read_dermis(path):
-    part = OpenEXR.File(path).parts[0]
-    ch = part.channels
+    """dermis's EXR (RGBA), or a Cycles one (Combined), to compare two variants."""
+    ch = OpenEXR.File(path).parts[0].channels
+    if "ViewLayer.Combined" in ch:
+        return ch["ViewLayer.Combined"].pixels.astype(np.float64)
     if "RGBA" in ch:
         return ch["RGBA"].pixels.astype(np.float64)
     return np.stack([ch[c].pixels for c in "RGBA"], -1).astype(np.float64)

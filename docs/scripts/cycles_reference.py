@@ -5,7 +5,7 @@ Run with the Python of a venv that holds the `bpy` wheel (docs/skin.md,
 
     python3 -m venv /work/bpy-venv && /work/bpy-venv/bin/pip install bpy==4.2.0 numpy OpenEXR
     /work/bpy-venv/bin/python docs/scripts/cycles_reference.py --out ref.exr \
-        --env uniform --width 192 --height 240 --samples 1024 --seed 1
+        --env uniform --sss-method skin --width 192 --height 240 --samples 1024 --seed 1
 
 The scan (assets/head/lee-perry-smith/, 50.3 mm per glTF unit) with its albedo,
 normal and specular maps; skin is Cycles' Principled BSDF (Blender 4's energy-
@@ -31,7 +31,7 @@ MM_PER_UNIT = 50.3  # assets/default.toml
 
 # Jensen, Marschner, Levoy & Hanrahan 2001, Table 1 "Skin1": sigma_s' = (0.74,
 # 0.88, 1.01)/mm, sigma_a = (0.032, 0.17, 0.48)/mm; the diffuse mean free path
-# 1/sqrt(3 sigma_a sigma_t') in mm. Cycles' random walk takes it as "radius".
+# 1/sqrt(3 sigma_a sigma_t') in mm: RANDOM_WALK_SKIN's "radius".
 SKIN1_MFP_MM = (3.67, 1.37, 0.68)
 SKIN_IOR = 1.4  # d'Eon & Luebke, GPU Gems 3 §14.3 (F0 = 0.028)
 
@@ -57,7 +57,7 @@ CAMERA_FOV_Y_DEG = 30.0
 def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument(
-        "--out", required=True, help="output .exr (multilayer); .json with --calibrate"
+        "--out", required=True, help="output .exr (multilayer); .json with --slab-reflectance"
     )
     p.add_argument(
         "--env",
@@ -97,16 +97,19 @@ def parse_args(argv):
         "the map's orientation against dermis's --skybox on)",
     )
     p.add_argument(
-        "--calibrate",
-        action="store_true",
-        help="render the slab (no specular) at base colours 0.02 ... 1 and write "
-        "its total reflectance under the uniform sky to --out (.json)",
+        "--sss-method",
+        choices=["skin", "walk"],
+        default="skin",
+        help="RANDOM_WALK_SKIN (the radius is the diffuse mean free path, entry "
+        "through the IOR) or RANDOM_WALK (index-matched; the radius / 4 pi and the "
+        "albedo's fit give the extinction)",
     )
     p.add_argument(
-        "--albedo-table",
-        metavar="FILE.json",
-        help="a --calibrate table: give the random walk the base colour whose "
-        "slab reflects the albedo map's value (dermis's meaning of albedo)",
+        "--slab-reflectance",
+        action="store_true",
+        help="the slab (no specular) at base colours 0.02 ... 1: its total "
+        "reflectance under the uniform sky and its radiance per exit angle, to "
+        "--out (.json)",
     )
     p.add_argument(
         "--view",
@@ -115,10 +118,8 @@ def parse_args(argv):
         help="albedo: the albedo map as emission (to check the UVs)",
     )
     args = p.parse_args(argv)
-    if not args.out.lower().endswith(".json" if args.calibrate else ".exr"):
-        p.error("--out must end in .json with --calibrate, else .exr")
-    if args.albedo_table is not None:
-        args.albedo_table = read_table(p, args.albedo_table)
+    if not args.out.lower().endswith(".json" if args.slab_reflectance else ".exr"):
+        p.error("--out must end in .json with --slab-reflectance, else .exr")
     out_dir = os.path.dirname(os.path.abspath(args.out))
     if not os.path.isdir(out_dir):
         p.error(f"--out: no folder {out_dir}")
@@ -137,19 +138,6 @@ def parse_args(argv):
     if args.bounces < 0 or args.seed < 0:
         p.error("--bounces and --seed must be >= 0")
     return args
-
-
-def read_table(p, path):
-    """A --calibrate table as (reflectance, base) pairs, checked monotone."""
-    try:
-        with open(path) as f:
-            t = json.load(f)
-        pairs = list(zip(t["reflectance"], t["base"]))
-    except (OSError, ValueError, KeyError, TypeError) as e:
-        p.error(f"--albedo-table {path}: {e}")
-    if len(pairs) < 2 or any(b[0] <= a[0] or b[1] <= a[1] for a, b in zip(pairs, pairs[1:])):
-        p.error(f"--albedo-table {path}: needs two or more increasing pairs")
-    return pairs
 
 
 def to_blender(v_mm):
@@ -198,26 +186,13 @@ def skin_material(args):
         links.new(emit.outputs["Emission"], out.inputs["Surface"])
         return mat
 
-    if args.albedo_table:
-        # Reflectance -> base colour, the inverse of the slab's curve (Cycles
-        # tabulates the curve; the points are interpolated smoothly).
-        curves = nodes.new("ShaderNodeRGBCurve")
-        curve = curves.mapping.curves[3]  # C: every channel
-        (r0, b0), rest = args.albedo_table[0], args.albedo_table[1:]
-        curve.points[0].location = (0.0, 0.0)
-        curve.points[1].location = (r0, b0)
-        for r, b in rest:
-            curve.points.new(r, b)
-        curves.mapping.use_clip = False
-        curves.mapping.update()
-        links.new(albedo.outputs["Color"], curves.inputs["Color"])
-        albedo = curves
-
     bsdf = nodes.new("ShaderNodeBsdfPrincipled")
     bsdf.distribution = "MULTI_GGX"
-    # The radius as given (RANDOM_WALK_SKIN would rescale it by the colour and
-    # refract at its own Subsurface IOR); the layer above refracts at IOR.
-    bsdf.subsurface_method = "RANDOM_WALK"
+    # Cycles' kernel/closure/bssrdf.h, bssrdf_setup_radius: RANDOM_WALK_SKIN
+    # scales the radius so that it is diffusion theory's 1/sigma_tr (Jensen's
+    # diffuse mean free path) at the IOR, and refracts on entry; RANDOM_WALK
+    # scales it by 1/(4 pi) and exits index-matched (docs/skin.md).
+    bsdf.subsurface_method = "RANDOM_WALK_SKIN" if args.sss_method == "skin" else "RANDOM_WALK"
     links.new(albedo.outputs["Color"], bsdf.inputs["Base Color"])
     bsdf.inputs["Metallic"].default_value = 0.0
     bsdf.inputs["Roughness"].default_value = math.sqrt(BECKMANN_M)
@@ -226,6 +201,8 @@ def skin_material(args):
     bsdf.inputs["Subsurface Radius"].default_value = SKIN1_MFP_MM
     bsdf.inputs["Subsurface Scale"].default_value = 1.0 / MM_PER_UNIT
     bsdf.inputs["Subsurface Anisotropy"].default_value = 0.0
+    if args.sss_method == "skin":
+        bsdf.inputs["Subsurface IOR"].default_value = SKIN_IOR
 
     level = bsdf.inputs["Specular IOR Level"]
     if args.slab:
@@ -309,14 +286,22 @@ def slab():
 
 
 def slab_camera():
-    """Orthographic, straight down, 20 mm across the slab's centre."""
+    """Orthographic, 20 mm across the slab's centre, straight down."""
     data = bpy.data.cameras.new("camera")
     data.type = "ORTHO"
     data.ortho_scale = 20.0 / MM_PER_UNIT
     cam = bpy.data.objects.new("camera", data)
-    cam.location = (0.0, 0.0, 500.0 / MM_PER_UNIT)
     bpy.context.scene.collection.objects.link(cam)
+    tilt_slab_camera(cam, 1.0)
     return cam
+
+
+def tilt_slab_camera(cam, mu):
+    """Look at the slab's centre from 500 mm away at cos(angle from normal) mu."""
+    a = math.acos(mu)
+    d = 500.0 / MM_PER_UNIT
+    cam.location = (0.0, -d * math.sin(a), d * math.cos(a))
+    cam.rotation_euler = (a, 0.0, 0.0)
 
 
 def camera(args):
@@ -340,8 +325,8 @@ def main():
     args = parse_args(argv)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    if args.calibrate:
-        args.slab, args.specular, args.sss, args.albedo_table = (0.5, 0.5, 0.5), "off", "on", None
+    if args.slab_reflectance:
+        args.slab, args.specular, args.sss = (0.5, 0.5, 0.5), "off", "on"
     head = slab() if args.slab else import_head()
     head.data.materials.clear()
     head.data.materials.append(skin_material(args))
@@ -391,8 +376,8 @@ def main():
     scene.render.filepath = tmp
     scene.render.use_file_extension = False
     try:
-        if args.calibrate:
-            calibrate(args, head.data.materials[0], tmp, out)
+        if args.slab_reflectance:
+            slab_reflectance(args, head.data.materials[0], tmp, out)
         else:
             bpy.ops.render.render(write_still=True)
             os.replace(tmp, out)
@@ -402,30 +387,38 @@ def main():
     print(f"wrote {out}", flush=True)
 
 
-def calibrate(args, material, tmp, out):
-    """The slab's total reflectance under the uniform sky (its radiance seen
-    from above) for base colours 0.02 ... 1, three per render."""
+def slab_reflectance(args, material, tmp, out):
+    """The slab's total (hemispherical) reflectance under the uniform sky of 1,
+    2 int_0^1 L(mu) mu dmu over the exit cosine mu, for base colours 0.02 ... 1
+    (three per render): the random walk's exit is not Lambertian, so its
+    radiance is read at the 4 Gauss-Legendre nodes of mu on [0, 1]."""
     import numpy as np
     import OpenEXR
 
     colour = next(n for n in material.node_tree.nodes if n.type == "RGB")
+    cam = bpy.context.scene.camera
+    nodes, weights = np.polynomial.legendre.leggauss(4)
+    mus, weights = (nodes + 1) / 2, weights / 2
     base = [0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0]
-    reflectance, stderr = [], []
+    radiance = np.zeros((len(mus), len(base)))
     for i in range(0, len(base), 3):
         colour.outputs["Color"].default_value = tuple(base[i : i + 3]) + (1.0,)
-        bpy.ops.render.render(write_still=True)
-        px = OpenEXR.File(tmp).parts[0].channels["ViewLayer.Combined"].pixels
-        rgb = px[..., :3].reshape(-1, 3).astype(np.float64)
-        reflectance += list(rgb.mean(0))
-        stderr += list(rgb.std(0) / np.sqrt(len(rgb)))
+        for k, mu in enumerate(mus):
+            tilt_slab_camera(cam, mu)
+            bpy.ops.render.render(write_still=True)
+            px = OpenEXR.File(tmp).parts[0].channels["ViewLayer.Combined"].pixels
+            radiance[k, i : i + 3] = px[..., :3].reshape(-1, 3).astype(np.float64).mean(0)
+    reflectance = 2 * (weights * mus) @ radiance
     table = {
-        "what": "Cycles random walk (spec off) on a slab under a uniform sky of 1",
+        "what": "Cycles random walk (no specular) on a slab under a uniform sky of 1: "
+        "hemispherical reflectance, and the radiance at each exit cosine mu",
         "blender": bpy.app.version_string,
         "samples": args.samples,
         "pixels": args.width * args.height,
         "base": base,
         "reflectance": [round(r, 5) for r in reflectance],
-        "stderr": [round(e, 5) for e in stderr],
+        "mu": [round(m, 5) for m in mus],
+        "radiance": [[round(r, 5) for r in row] for row in radiance],
     }
     part = out + ".tmp"
     with open(part, "w") as f:
