@@ -1,0 +1,482 @@
+"""A path-traced reference of dermis's default scene in Blender's Cycles (>= 4.0).
+
+Run with the Python of a venv that holds the `bpy` wheel (docs/skin.md,
+"Against a path tracer"):
+
+    python3 -m venv /work/bpy-venv && /work/bpy-venv/bin/pip install bpy==4.2.0 numpy OpenEXR
+    /work/bpy-venv/bin/python docs/scripts/cycles_reference.py --out ref.exr \
+        --env uniform --sss-method skin --width 192 --height 240 --samples 1024 --seed 1
+
+The scan (assets/head/lee-perry-smith/, 50.3 mm per glTF unit) with its albedo,
+normal and specular maps; skin is Cycles' Principled BSDF (Blender 4's energy-
+conserving dielectric layer over the base) with random-walk subsurface
+scattering at Jensen et al. 2001's skin1 diffuse mean free paths; the camera
+and environment of assets/default.toml. Output: a multilayer linear EXR
+(Standard view transform, no denoising), layers Combined (alpha = coverage) and
+Position (world, Blender units, Z up), written to a temporary file and renamed.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+import bpy
+from mathutils import Matrix, Vector
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+HEAD = os.path.join(REPO, "assets", "head", "lee-perry-smith")
+MM_PER_UNIT = 50.3  # assets/default.toml
+
+# Jensen, Marschner, Levoy & Hanrahan 2001, Table 1 "Skin1": sigma_s' = (0.74,
+# 0.88, 1.01)/mm, sigma_a = (0.032, 0.17, 0.48)/mm; the diffuse mean free path
+# 1/sqrt(3 sigma_a sigma_t') in mm: RANDOM_WALK_SKIN's "radius".
+SKIN1_MFP_MM = (3.67, 1.37, 0.68)
+SKIN_IOR = 1.4  # d'Eon & Luebke, GPU Gems 3 §14.3 (F0 = 0.028)
+
+# dermis's specular (src/skin/specular.rs, docs/skin.md "Calibration"): rho_s =
+# 0.18 (1 + (0.16/0.18) t), t = min(s / (2 s_mean), 1), s the specular map's red
+# channel (linear) and s_mean = 0.244 its area-weighted mean over the scan; the KS
+# lobe at rho_s is rho_s/0.35 of a dielectric of F0 0.028 (0.736 at rho_s =
+# 0.2575, normal incidence). Cycles' Specular IOR Level scales F0 by 2 x level.
+KS_RHO_S = 0.18
+KS_MAP_GAIN = 0.16 / 0.18
+SPEC_MAP_MEAN = 0.244
+KS_RHO_S_DIELECTRIC = 0.35
+# Beckmann m = 0.3 (d'Eon's default, every region of the scan); Walter et al.
+# 2007 match GGX's alpha to Beckmann's m; Blender's roughness is sqrt(alpha).
+BECKMANN_M = 0.3
+
+# assets/default.toml, in mm, +Y up.
+CAMERA_POSITION_MM = (229.0, 119.0, 629.0)
+CAMERA_TARGET_MM = (0.0, 60.0, 0.0)
+CAMERA_FOV_Y_DEG = 30.0
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument(
+        "--out", required=True, help="output .exr (multilayer); .json with --slab-reflectance"
+    )
+    p.add_argument(
+        "--env",
+        default="uniform",
+        help="'uniform' (radiance 1, dermis: uniform:1,1,1) or a lat-long .hdr/.exr",
+    )
+    p.add_argument("--width", type=int, default=192)
+    p.add_argument("--height", type=int, default=240)
+    p.add_argument("--samples", type=int, default=1024)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument(
+        "--sss", choices=["on", "off"], default="on", help="off: Lambertian base"
+    )
+    p.add_argument(
+        "--specular",
+        choices=["map", "dielectric", "off"],
+        default="map",
+        help="map: dermis's spatial strength; dielectric: IOR 1.4 everywhere",
+    )
+    p.add_argument(
+        "--bounces",
+        type=int,
+        default=8,
+        help="max diffuse and glossy bounces (the SSS exit counts as one)",
+    )
+    p.add_argument(
+        "--slab",
+        metavar="R,G,B",
+        help="instead of the head: a flat slab 1 m wide, 100 mm thick, of this "
+        "linear albedo (no maps; specular at the map's mean), seen from above",
+    )
+    p.add_argument(
+        "--skybox",
+        action="store_true",
+        help="show the environment behind the head (alpha 1 there: only to check "
+        "the map's orientation against dermis's --skybox on)",
+    )
+    p.add_argument(
+        "--sss-method",
+        choices=["skin", "walk"],
+        default="skin",
+        help="RANDOM_WALK_SKIN (the radius is the diffuse mean free path, entry "
+        "through the IOR) or RANDOM_WALK (index-matched; the radius / 4 pi and the "
+        "albedo's fit give the extinction)",
+    )
+    p.add_argument(
+        "--slab-reflectance",
+        action="store_true",
+        help="the slab (no specular) at base colours 0.02 ... 1: its total "
+        "reflectance under the uniform sky and its radiance per exit angle, to "
+        "--out (.json)",
+    )
+    p.add_argument(
+        "--view",
+        choices=["final", "albedo"],
+        default="final",
+        help="albedo: the albedo map as emission (to check the UVs)",
+    )
+    args = p.parse_args(argv)
+    if not args.out.lower().endswith(".json" if args.slab_reflectance else ".exr"):
+        p.error("--out must end in .json with --slab-reflectance, else .exr")
+    out_dir = os.path.dirname(os.path.abspath(args.out))
+    if not os.path.isdir(out_dir):
+        p.error(f"--out: no folder {out_dir}")
+    if args.env != "uniform" and not os.path.isfile(args.env):
+        p.error(f"--env: no file {args.env}")
+    if args.slab is not None:
+        try:
+            args.slab = tuple(float(c) for c in args.slab.split(","))
+        except ValueError:
+            p.error("--slab takes three numbers R,G,B")
+        if len(args.slab) != 3 or not all(0.0 <= c <= 1.0 for c in args.slab):
+            p.error("--slab takes three numbers in [0, 1]")
+    for name in ("width", "height", "samples", "threads"):
+        if getattr(args, name) < 1:
+            p.error(f"--{name} must be >= 1")
+    if args.bounces < 0 or args.seed < 0:
+        p.error("--bounces and --seed must be >= 0")
+    return args
+
+
+def to_blender(v_mm):
+    """dermis world (mm, +Y up) to Blender's (units, +Z up), as the glTF importer
+    turns the mesh: (x, y, z) -> (x, -z, y)."""
+    x, y, z = (c / MM_PER_UNIT for c in v_mm)
+    return Vector((x, -z, y))
+
+
+def import_head():
+    bpy.ops.import_scene.gltf(filepath=os.path.join(HEAD, "LeePerrySmith.glb"))
+    meshes = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    if len(meshes) != 1:
+        raise SystemExit(f"expected one mesh in the GLB, found {len(meshes)}")
+    head = meshes[0]
+    # The importer flips v (v' = 1 - v) for glTF's top-left origin; the scan's
+    # maps are authored for a bottom-left origin (assets/default.toml), so the
+    # glTF v is already Blender's. Flip back in the mesh, not the lookup, so the
+    # tangents the normal map uses follow the v the maps were painted for.
+    for loop_uv in head.data.uv_layers.active.data:
+        loop_uv.uv[1] = 1.0 - loop_uv.uv[1]
+    return head
+
+
+def image(name, colorspace):
+    img = bpy.data.images.load(os.path.join(HEAD, name))
+    img.colorspace_settings.name = colorspace
+    return img
+
+
+def skin_material(args):
+    mat = bpy.data.materials.new("skin")
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    if args.slab:
+        albedo = nodes.new("ShaderNodeRGB")
+        albedo.outputs["Color"].default_value = args.slab + (1.0,)
+    else:
+        albedo = nodes.new("ShaderNodeTexImage")
+        albedo.image = image("Map-COL.jpg", "sRGB")
+    if args.view == "albedo":
+        emit = nodes.new("ShaderNodeEmission")
+        links.new(albedo.outputs["Color"], emit.inputs["Color"])
+        links.new(emit.outputs["Emission"], out.inputs["Surface"])
+        return mat
+
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.distribution = "MULTI_GGX"
+    # Cycles' kernel/closure/bssrdf.h, bssrdf_setup_radius: RANDOM_WALK_SKIN
+    # scales the radius so that it is diffusion theory's 1/sigma_tr (Jensen's
+    # diffuse mean free path) at the IOR, and refracts on entry; RANDOM_WALK
+    # scales it by 1/(4 pi) and exits index-matched (docs/skin.md).
+    bsdf.subsurface_method = "RANDOM_WALK_SKIN" if args.sss_method == "skin" else "RANDOM_WALK"
+    links.new(albedo.outputs["Color"], bsdf.inputs["Base Color"])
+    bsdf.inputs["Metallic"].default_value = 0.0
+    bsdf.inputs["Roughness"].default_value = math.sqrt(BECKMANN_M)
+    bsdf.inputs["IOR"].default_value = SKIN_IOR
+    bsdf.inputs["Subsurface Weight"].default_value = 1.0 if args.sss == "on" else 0.0
+    bsdf.inputs["Subsurface Radius"].default_value = SKIN1_MFP_MM
+    bsdf.inputs["Subsurface Scale"].default_value = 1.0 / MM_PER_UNIT
+    bsdf.inputs["Subsurface Anisotropy"].default_value = 0.0
+    if args.sss_method == "skin":
+        bsdf.inputs["Subsurface IOR"].default_value = SKIN_IOR
+
+    level = bsdf.inputs["Specular IOR Level"]
+    if args.slab:
+        # The map's mean everywhere: t = 1/2.
+        rho_s = KS_RHO_S * (1.0 + 0.5 * KS_MAP_GAIN)
+        level.default_value = 0.5 * rho_s / KS_RHO_S_DIELECTRIC if args.specular == "map" else 0.0
+        if args.specular == "dielectric":
+            level.default_value = 0.5
+        links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+        return mat
+
+    normal_tex = nodes.new("ShaderNodeTexImage")
+    normal_tex.image = image("Infinite-Level_02_Tangent_SmoothUV.jpg", "Non-Color")
+    normal_map = nodes.new("ShaderNodeNormalMap")
+    normal_map.space = "TANGENT"
+    links.new(normal_tex.outputs["Color"], normal_map.inputs["Color"])
+    links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+
+    if args.specular == "off":
+        level.default_value = 0.0
+    elif args.specular == "dielectric":
+        level.default_value = 0.5
+    else:
+        spec = nodes.new("ShaderNodeTexImage")
+        spec.image = image("Map-SPEC.jpg", "Non-Color")
+        red = nodes.new("ShaderNodeSeparateColor")
+        links.new(spec.outputs["Color"], red.inputs["Color"])
+        # t = min(s / (2 s_mean), 1)
+        t = nodes.new("ShaderNodeMath")
+        t.operation = "MULTIPLY"
+        t.use_clamp = True
+        t.inputs[1].default_value = 1.0 / (2.0 * SPEC_MAP_MEAN)
+        links.new(red.outputs["Red"], t.inputs[0])
+        # level = 0.5 rho_s / rho_s(dielectric) = a t + b
+        scale = 0.5 * KS_RHO_S / KS_RHO_S_DIELECTRIC
+        lvl = nodes.new("ShaderNodeMath")
+        lvl.operation = "MULTIPLY_ADD"
+        lvl.inputs[1].default_value = scale * KS_MAP_GAIN
+        lvl.inputs[2].default_value = scale
+        links.new(t.outputs["Value"], lvl.inputs[0])
+        links.new(lvl.outputs["Value"], level)
+    links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
+def world(args):
+    w = bpy.data.worlds.new("env")
+    w.use_nodes = True
+    nodes, links = w.node_tree.nodes, w.node_tree.links
+    bg = nodes["Background"]
+    bg.inputs["Strength"].default_value = 1.0
+    if args.view == "albedo":
+        bg.inputs["Color"].default_value = (0, 0, 0, 1)
+    elif args.env == "uniform":
+        bg.inputs["Color"].default_value = (1, 1, 1, 1)
+    else:
+        tex = nodes.new("ShaderNodeTexEnvironment")
+        tex.image = bpy.data.images.load(os.path.abspath(args.env))
+        tex.image.colorspace_settings.name = "Linear Rec.709"
+        tex.interpolation = "Closest"  # dermis's reference: piecewise constant
+        # Cycles looks up u = 0.5 - atan2(y, x)/2pi (Blender axes), so u = 0.5
+        # looks along +X; dermis's u = 0.5 looks along its -Z, Blender's +Y
+        # (docs/lighting.md). Turning the direction by -90° about Z first gives
+        # dermis's u.
+        coord = nodes.new("ShaderNodeTexCoord")
+        mapping = nodes.new("ShaderNodeMapping")
+        mapping.vector_type = "VECTOR"
+        mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(-90.0))
+        links.new(coord.outputs["Generated"], mapping.inputs["Vector"])
+        links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+        links.new(tex.outputs["Color"], bg.inputs["Color"])
+    return w
+
+
+def slab():
+    """A 1 m x 1 m x 100 mm box, top face at z = 0 (Blender units)."""
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, -50.0 / MM_PER_UNIT))
+    box = bpy.context.active_object
+    box.scale = (1000.0 / MM_PER_UNIT, 1000.0 / MM_PER_UNIT, 100.0 / MM_PER_UNIT)
+    return box
+
+
+def slab_camera():
+    """Orthographic, 20 mm across the slab's centre, straight down."""
+    data = bpy.data.cameras.new("camera")
+    data.type = "ORTHO"
+    data.ortho_scale = 20.0 / MM_PER_UNIT
+    cam = bpy.data.objects.new("camera", data)
+    bpy.context.scene.collection.objects.link(cam)
+    tilt_slab_camera(cam, 1.0)
+    return cam
+
+
+def tilt_slab_camera(cam, mu):
+    """Look at the slab's centre from 500 mm away at cos(angle from normal) mu."""
+    a = math.acos(mu)
+    d = 500.0 / MM_PER_UNIT
+    cam.location = (0.0, -d * math.sin(a), d * math.cos(a))
+    cam.rotation_euler = (a, 0.0, 0.0)
+
+
+def camera(args):
+    data = bpy.data.cameras.new("camera")
+    data.sensor_fit = "VERTICAL"
+    data.angle_y = math.radians(CAMERA_FOV_Y_DEG)
+    data.clip_start = 0.01
+    data.clip_end = 1000.0
+    cam = bpy.data.objects.new("camera", data)
+    eye = to_blender(CAMERA_POSITION_MM)
+    target = to_blender(CAMERA_TARGET_MM)
+    # Look along -Z with +Y up, dermis's look_at with world up (+Y, Blender's +Z).
+    rot = (target - eye).to_track_quat("-Z", "Y").to_matrix().to_4x4()
+    cam.matrix_world = Matrix.Translation(eye) @ rot
+    bpy.context.scene.collection.objects.link(cam)
+    return cam
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
+    args = parse_args(argv)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    if args.slab_reflectance:
+        args.slab, args.specular, args.sss = (0.5, 0.5, 0.5), "off", "on"
+    head = slab() if args.slab else import_head()
+    head.data.materials.clear()
+    head.data.materials.append(skin_material(args))
+    scene.world = world(args)
+    scene.camera = slab_camera() if args.slab else camera(args)
+
+    scene.render.engine = "CYCLES"
+    cy = scene.cycles
+    cy.device = "CPU"
+    cy.samples = args.samples
+    cy.seed = args.seed
+    cy.use_adaptive_sampling = False
+    cy.use_denoising = False
+    cy.sample_clamp_direct = 0.0
+    cy.sample_clamp_indirect = 0.0
+    cy.max_bounces = max(args.bounces, 1)
+    cy.diffuse_bounces = args.bounces
+    cy.glossy_bounces = args.bounces
+    cy.transmission_bounces = args.bounces
+    cy.transparent_max_bounces = 8
+    cy.caustics_reflective = True
+    cy.caustics_refractive = True
+    cy.blur_glossy = 0.0
+    # Box filter over the pixel: the pixel's mean, as dermis's mip-mapped maps.
+    cy.pixel_filter_type = "BOX"
+    cy.filter_width = 1.0
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = args.threads
+    scene.render.resolution_x = args.width
+    scene.render.resolution_y = args.height
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = not args.skybox
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    scene.render.use_compositing = False
+    scene.render.use_sequencer = False
+    scene.view_layers[0].use_pass_position = True
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+
+    out = os.path.abspath(args.out)
+    tmp = os.path.join(os.path.dirname(out), "." + os.path.basename(out) + ".tmp.exr")
+    scene.render.filepath = tmp
+    scene.render.use_file_extension = False
+    try:
+        if args.slab_reflectance:
+            slab_reflectance(args, head.data.materials[0], tmp, out)
+        else:
+            bpy.ops.render.render(write_still=True)
+            os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    print(f"wrote {out}", flush=True)
+
+
+def slab_reflectance(args, material, tmp, out):
+    """The slab's total (hemispherical) reflectance under the uniform sky of 1,
+    2 int_0^1 L(mu) mu dmu over the exit cosine mu, for base colours 0.02 ... 1
+    (three per render): the random walk's exit is not Lambertian, so its
+    radiance is read at the 4 Gauss-Legendre nodes of mu on [0, 1]."""
+    import numpy as np
+    import OpenEXR
+
+    colour = next(n for n in material.node_tree.nodes if n.type == "RGB")
+    cam = bpy.context.scene.camera
+    nodes, weights = np.polynomial.legendre.leggauss(4)
+    mus, weights = (nodes + 1) / 2, weights / 2
+    base = [0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0]
+    radiance = np.zeros((len(mus), len(base)))
+    for i in range(0, len(base), 3):
+        colour.outputs["Color"].default_value = tuple(base[i : i + 3]) + (1.0,)
+        for k, mu in enumerate(mus):
+            tilt_slab_camera(cam, mu)
+            bpy.ops.render.render(write_still=True)
+            px = OpenEXR.File(tmp).parts[0].channels["ViewLayer.Combined"].pixels
+            radiance[k, i : i + 3] = px[..., :3].reshape(-1, 3).astype(np.float64).mean(0)
+    reflectance = 2 * (weights * mus) @ radiance
+    table = {
+        "what": "Cycles random walk (no specular) on a slab under a uniform sky of 1: "
+        "hemispherical reflectance, and the radiance at each exit cosine mu",
+        "blender": bpy.app.version_string,
+        "samples": args.samples,
+        "pixels": args.width * args.height,
+        "base": base,
+        "reflectance": [round(r, 5) for r in reflectance],
+        "mu": [round(m, 5) for m in mus],
+        "radiance": [[round(r, 5) for r in row] for row in radiance],
+        "edge": shadow_edge(colour, cam, tmp),
+    }
+    part = out + ".tmp"
+    with open(part, "w") as f:
+        json.dump(table, f, indent=1)
+    os.replace(part, out)
+
+
+def shadow_edge(colour, cam, tmp):
+    """How far the walk carries light: the slab at the scan's mean albedo under
+    a sun straight above, a half-plane 3 mm over it shading x < 0, no sky; the
+    distance from 25 % to 75 % of the lit level across the shadow's edge, per
+    channel (a profile R(r) gives the edge integral of R over the half plane)."""
+    import numpy as np
+    import OpenEXR
+
+    scene = bpy.context.scene
+    albedo = (0.58, 0.33, 0.28)  # the scan's mean linear albedo (--view albedo)
+    colour.outputs["Color"].default_value = albedo + (1.0,)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
+    sun.data.energy, sun.data.angle = 1.0, 0.0
+    scene.collection.objects.link(sun)
+    bpy.ops.mesh.primitive_plane_add(size=1.0)
+    blocker = bpy.context.active_object
+    blocker.scale = (400.0 / MM_PER_UNIT, 1000.0 / MM_PER_UNIT, 1.0)
+    blocker.location = (-200.0 / MM_PER_UNIT, 0.0, 3.0 / MM_PER_UNIT)
+    across_mm = 24.0
+    tilt_slab_camera(cam, 1.0)
+    cam.location = (0.0, 0.0, 2.0 / MM_PER_UNIT)  # under the blocker
+    cam.data.clip_start = 1e-3
+    cam.data.ortho_scale = across_mm / MM_PER_UNIT
+    scene.render.resolution_x, scene.render.resolution_y = 192, 8
+    bpy.ops.render.render(write_still=True)
+    px = OpenEXR.File(tmp).parts[0].channels["ViewLayer.Combined"].pixels
+    row = px[..., :3].astype(np.float64).mean(0)
+    x = (np.arange(len(row)) + 0.5) / len(row) * across_mm - across_mm / 2
+    lit = row[-24:].mean(0)
+
+    def crossing(f, t):
+        """Where f first rises through t, linear between pixels."""
+        i = int(np.argmax(f > t))
+        return x[i - 1] + (t - f[i - 1]) / (f[i] - f[i - 1]) * (x[i] - x[i - 1])
+
+    widths = []
+    for c in range(3):
+        f = row[:, c] / lit[c]
+        widths.append(float(crossing(f, 0.75) - crossing(f, 0.25)))
+    return {
+        "albedo": albedo,
+        "mm_per_pixel": across_mm / len(row),
+        "lit_radiance": [round(v, 5) for v in lit],
+        "width_25_75_mm": [round(w, 3) for w in widths],
+    }
+
+
+if __name__ == "__main__":
+    main()
+    # bpy 4.2 can crash in its own teardown at exit (SIGSEGV after the file is
+    # written); leave without it.
+    os._exit(0)
