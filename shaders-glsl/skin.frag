@@ -31,6 +31,7 @@ layout(binding = 12) uniform sampler2D blur6;
 #define SPEC_REGIONS 15
 #define SPEC_INTENSITY 16
 #define SPEC_ROUGHNESS 17
+#define SPEC_HEMISPHERICAL 22
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
@@ -114,6 +115,12 @@ void main() {
     // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
     // §14.3), taken from the diffuse and given to the environment's specular.
     float reflected = params.x * specular_albedo(n_dot_v, params.y);
+    // What the oil layer reflects back inward on exit stays in the skin and
+    // leaves later: the exit factor 1 − ρs·A(N·V) renormalised by its
+    // hemispherical mean 1 − ρs·Ā(m), so that light entering leaves whole and a
+    // white surface under a white sky reflects 1 (Kelemen & Szirmay-Kalos
+    // 2001's coupled diffuse term; docs/skin.md, "White furnace").
+    float exit = (1.0 - reflected) / max(diffuse_transmission_uniform(params), 1e-3);
     // The transmitted light enters with the pre-scatter albedo, as the
     // irradiance does (x's own albedo for the far side's).
     vec3 through = vec3(0.0);
@@ -122,7 +129,7 @@ void main() {
         through = transmitted(v_position, ng, n, params) * pow(albedo, vec3(pc.mix_pre));
         diffuse += through;
     }
-    vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * (1.0 - reflected);
+    vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit;
     vec3 spec = vec3(0.0);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
@@ -134,7 +141,7 @@ void main() {
     float visibility = OCCLUSION ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
     spec += reflected * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
     if (pc.mode == 3u) {
-        color = vec4(through * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * (1.0 - reflected), 1.0);
+        color = vec4(through * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit, 1.0);
         return;
     }
     color = vec4(pc.mode == 1u ? sss : pc.mode == 2u ? spec : sss + spec, 1.0);

@@ -531,6 +531,34 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
     );
 }
 
+#[test]
+fn a_white_sphere_under_a_white_sky_reflects_it_whole() {
+    // The white furnace through the whole frame: albedo 1, no occlusion, a
+    // uniform L. The specular takes ρs·Ā(m) of the light entering and reflects
+    // ρs·A(N·V, m)·L toward the viewer; the diffuse leaves with the exit factor
+    // renormalised by 1 − ρs·Ā(m): in all, L at every angle.
+    let radiance = 2.0;
+    let mut s = scene(
+        sphere(Vec3::ZERO, R, 96, 48, (0.0, 1.0)),
+        Vec::new(),
+        EnvMap::uniform(Vec3::splat(radiance), 64, 32),
+    );
+    s.albedo = Texture::solid([255, 255, 255, 255], Encoding::Srgb);
+    let img = render(&s, View::FINAL);
+    let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
+        .into_iter()
+        .map(|h| {
+            let (_, p) = h?;
+            let cos = p.normalize().dot((s.camera.position - p).normalize());
+            (cos >= 0.3).then_some(radiance)
+        })
+        .collect();
+    for c in 0..3 {
+        let (n, _) = compare("white furnace", |i| img[i * 4 + c], &expected);
+        assert!(n > 10_000, "{n}");
+    }
+}
+
 /// Relative errors (max over channels) of the GPU prefiltered environment of
 /// the CC0 map `name` with `lights` extracted against brute force integration of
 /// what it prefilters (the map less those sources), on a grid of texels of
