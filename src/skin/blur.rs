@@ -2,7 +2,9 @@
 //! Fig. 3): level k blurs level k−1 by σ_k = √(v_k − v_{k−1}) mm, separably (U then
 //! V), with taps spaced by the stretch map's level k−1 (skin::stretch). Levels
 //! may be coarser than their predecessor (skin::chain): the U pass then writes
-//! the new width, the V pass the new height.
+//! the new width, the V pass the new height. A level narrower than a texel
+//! (chain::ONE_PASS_SIGMA_TEXELS) is blurred in one pass, `blurK`, by the 3×3
+//! stencil of its covariance (blur_narrow.comp), whichever kernel is chosen.
 //!
 //! Every UV target is coverage-premultiplied (alpha = 1 on the mesh, 0 in the
 //! gutter), so the chain is a plain linear convolution of (I·a, a) and dividing by
@@ -40,6 +42,8 @@ pub enum BlurKernel {
 
 pub struct BlurChain {
     pipeline: Arc<Pipeline>,
+    /// Both directions of a Gaussian narrower than a texel (blur_narrow.comp).
+    narrow: Arc<Pipeline>,
     taps: Arc<Buffer>,
     sampler: Arc<Sampler>,
     /// The stretch maps hold the shear (skin.shear_correction): the V pass
@@ -75,6 +79,7 @@ impl BlurChain {
         };
         Ok(Self {
             pipeline: pipelines.compute("blur.comp", &[tap_count])?,
+            narrow: pipelines.compute("blur_narrow.comp", &[])?,
             taps: upload_buffer(
                 ctx,
                 "blur kernel",
@@ -107,7 +112,17 @@ impl BlurChain {
             let desc = ImageDesc::new(level.resolution, level.resolution, UV_FORMAT);
             let mut dst = g.create_image(&name, desc);
             let src = out.last().unwrap_or(irradiance);
-            self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            if level.one_pass {
+                g.simple_pass(&name, &self.narrow)
+                    .tag(super::TAG)
+                    .sample(src, &self.sampler)
+                    .sample(&stretch[k], &self.sampler)
+                    .store(&mut dst)
+                    .constants(&sigma)
+                    .dispatch([level.resolution, level.resolution, 1]);
+            } else {
+                self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            }
             out.push(dst);
         }
         out

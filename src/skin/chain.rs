@@ -5,6 +5,8 @@
 //! low-pass filter), and takes the unblurred irradiance for a first Gaussian
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
 //! first term). docs/performance.md shows what it costs and how far it is off.
+//! Either way a level whose blur spans under [`ONE_PASS_SIGMA_TEXELS`] texels at
+//! its source's resolution is blurred in one pass instead of two (issue 24).
 
 use super::profile::Profile;
 use crate::scene::file::Chain;
@@ -19,6 +21,11 @@ pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
 /// The coarsest level the adaptive chain goes down to.
 pub const MIN_RESOLUTION: u32 = 64;
+/// Largest σ increment, in texels at the mesh's mean stretch, a level that keeps
+/// its source's resolution is blurred by in one pass (blur_narrow.comp): a 3×3
+/// stencil holds it, and its tent m/2, 1 − m, m/2 of variance m = σ² stays
+/// highest at the centre up to m = 2/3 (σ = 0.82 texels).
+pub const ONE_PASS_SIGMA_TEXELS: f32 = 0.8;
 
 /// One level of the chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +36,9 @@ pub struct Level {
     /// the level is the previous image, unblurred (an adaptive first level under
     /// [`SKIP_SIGMA_TEXELS`], or any level of a profile scaled to zero width).
     pub sigma_mm: Option<f32>,
+    /// The blur spans under [`ONE_PASS_SIGMA_TEXELS`] and keeps the previous
+    /// image's resolution: one pass, both directions (skin::blur).
+    pub one_pass: bool,
 }
 
 /// Plans the six levels. `texels_per_mm`: the stretch the adaptive choice is made
@@ -38,22 +48,16 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
     let (mut previous_variance, mut previous_resolution) = (0.0f32, resolution);
     for (k, g) in profile.gaussians.iter().enumerate() {
         let increment = (g.variance_mm2 - previous_variance).max(0.0).sqrt();
-        let level = match chain {
+        let (side, sigma_mm) = match chain {
             // `skin.blur_width = 0`: every level is the irradiance.
-            _ if increment == 0.0 => Level {
-                resolution: previous_resolution,
-                sigma_mm: None,
-            },
-            Chain::Full => Level {
-                resolution,
-                sigma_mm: Some(increment),
-            },
+            _ if increment == 0.0 => (previous_resolution, None),
+            Chain::Full => (resolution, Some(increment)),
             // The first, narrowest level keeps the full resolution (d'Eon & Luebke
             // §14.5): the irradiance itself when its blur is under SKIP_SIGMA_TEXELS.
-            Chain::Adaptive if k == 0 => Level {
+            Chain::Adaptive if k == 0 => (
                 resolution,
-                sigma_mm: (increment * texels_per_mm >= SKIP_SIGMA_TEXELS).then_some(increment),
-            },
+                (increment * texels_per_mm >= SKIP_SIGMA_TEXELS).then_some(increment),
+            ),
             Chain::Adaptive => {
                 let sigma = g.variance_mm2.sqrt();
                 let mut r = previous_resolution;
@@ -63,11 +67,15 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
                 {
                     r /= 2;
                 }
-                Level {
-                    resolution: r,
-                    sigma_mm: Some(increment),
-                }
+                (r, Some(increment))
             }
+        };
+        let texels = |sigma: f32| sigma * texels_per_mm * side as f32 / resolution as f32;
+        let level = Level {
+            resolution: side,
+            sigma_mm,
+            one_pass: side == previous_resolution
+                && sigma_mm.is_some_and(|s| texels(s) <= ONE_PASS_SIGMA_TEXELS),
         };
         if level.sigma_mm.is_some() {
             previous_variance = g.variance_mm2;
@@ -149,7 +157,8 @@ mod tests {
                     l,
                     Level {
                         resolution: 1024,
-                        sigma_mm: None
+                        sigma_mm: None,
+                        one_pass: false,
                     }
                 );
             }
