@@ -113,13 +113,7 @@ impl BlurChain {
             let mut dst = g.create_image(&name, desc);
             let src = out.last().unwrap_or(irradiance);
             if level.one_pass {
-                g.simple_pass(&name, &self.narrow)
-                    .tag(super::TAG)
-                    .sample(src, &self.sampler)
-                    .sample(&stretch[k], &self.sampler)
-                    .store(&mut dst)
-                    .constants(&sigma)
-                    .dispatch([level.resolution, level.resolution, 1]);
+                self.narrow(g, &name, src, &stretch[k], sigma, &mut dst);
             } else {
                 self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
             }
@@ -179,6 +173,27 @@ impl BlurChain {
         let u = format!("{name}_u");
         self.pass(g, &u, (src, stretch), &mut tmp, along([1, 0]));
         self.pass(g, &format!("{name}_v"), (&tmp, stretch), dst, along([0, 1]));
+    }
+
+    /// One Gaussian of σ mm narrower than a texel, both directions in one pass
+    /// `name`, from `src` into `dst` of the same size (blur_narrow.comp).
+    pub fn narrow(
+        &self,
+        g: &mut Graph,
+        name: &str,
+        src: &ImageHandle,
+        stretch: &ImageHandle,
+        sigma_mm: f32,
+        dst: &mut ImageHandle,
+    ) {
+        let (w, h) = (dst.desc.width, dst.desc.height);
+        g.simple_pass(name, &self.narrow)
+            .tag(super::TAG)
+            .sample(src, &self.sampler)
+            .sample(stretch, &self.sampler)
+            .store(dst)
+            .constants(&sigma_mm)
+            .dispatch([w, h, 1]);
     }
 
     fn pass(
