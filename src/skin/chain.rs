@@ -5,8 +5,8 @@
 //! low-pass filter), and takes the unblurred irradiance for a first Gaussian
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
 //! first term). docs/performance.md shows what it costs and how far it is off.
-//! Either way a level whose blur spans under [`ONE_PASS_SIGMA_TEXELS`] texels at
-//! its source's resolution is blurred in one pass instead of two (issue 24).
+//! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
+//! of its source's resolution is blurred in one pass instead of two (issue 24).
 
 use super::profile::Profile;
 use crate::scene::file::Chain;
@@ -21,11 +21,36 @@ pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
 /// The coarsest level the adaptive chain goes down to.
 pub const MIN_RESOLUTION: u32 = 64;
-/// Largest σ increment, in texels at the mesh's mean stretch, a level that keeps
-/// its source's resolution is blurred by in one pass (blur_narrow.comp): a 3×3
-/// stencil holds it, and its tent m/2, 1 − m, m/2 of variance m = σ² stays
-/// highest at the centre up to m = 2/3 (σ = 0.82 texels).
-pub const ONE_PASS_SIGMA_TEXELS: f32 = 0.8;
+/// The texel neighbourhood of a level blurred in one pass (blur_narrow.comp),
+/// both directions at once, from a source of its own resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stencil {
+    /// 3×3, four bilinear taps: per axis the tent m/2, 1 − m, m/2 of variance
+    /// m = σ², highest at the centre up to m = 2/3.
+    Three,
+    /// 5×5, nine bilinear taps: per axis weights at 0, ±1, ±2 texels in the
+    /// Gaussian's ratio, with a centre weight up to m ≈ 1.9.
+    Five,
+}
+
+impl Stencil {
+    /// The largest σ increment, in texels at the mesh's mean stretch, this
+    /// stencil is used for (below the limits above, leaving room for a stretch
+    /// above the mean).
+    pub fn max_sigma_texels(self) -> f32 {
+        match self {
+            Stencil::Three => 0.8,
+            Stencil::Five => 1.2,
+        }
+    }
+
+    /// The smallest stencil for a blur of `sigma_texels`; `None`: two passes.
+    fn for_sigma(sigma_texels: f32) -> Option<Self> {
+        [Stencil::Three, Stencil::Five]
+            .into_iter()
+            .find(|s| sigma_texels <= s.max_sigma_texels())
+    }
+}
 
 /// One level of the chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,9 +61,9 @@ pub struct Level {
     /// the level is the previous image, unblurred (an adaptive first level under
     /// [`SKIP_SIGMA_TEXELS`], or any level of a profile scaled to zero width).
     pub sigma_mm: Option<f32>,
-    /// The blur spans under [`ONE_PASS_SIGMA_TEXELS`] and keeps the previous
-    /// image's resolution: one pass, both directions (skin::blur).
-    pub one_pass: bool,
+    /// The blur is narrow and keeps the previous image's resolution: one pass,
+    /// both directions, over this stencil (skin::blur); `None`: U then V.
+    pub one_pass: Option<Stencil>,
 }
 
 /// Plans the six levels. `texels_per_mm`: the stretch the adaptive choice is made
@@ -74,8 +99,9 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
         let level = Level {
             resolution: side,
             sigma_mm,
-            one_pass: side == previous_resolution
-                && sigma_mm.is_some_and(|s| texels(s) <= ONE_PASS_SIGMA_TEXELS),
+            one_pass: sigma_mm
+                .filter(|_| side == previous_resolution)
+                .and_then(|s| Stencil::for_sigma(texels(s))),
         };
         if level.sigma_mm.is_some() {
             previous_variance = g.variance_mm2;
@@ -158,7 +184,7 @@ mod tests {
                     Level {
                         resolution: 1024,
                         sigma_mm: None,
-                        one_pass: false,
+                        one_pass: None,
                     }
                 );
             }
