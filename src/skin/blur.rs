@@ -42,7 +42,8 @@ pub enum BlurKernel {
 
 pub struct BlurChain {
     pipeline: Arc<Pipeline>,
-    /// Both directions of a narrow Gaussian (blur_narrow.comp): 3×3, 5×5.
+    /// Both directions of a narrow Gaussian (blur_narrow.comp), indexed by
+    /// `Stencil as usize`, which is also the shader's FIVE constant.
     narrow: [Arc<Pipeline>; 2],
     taps: Arc<Buffer>,
     sampler: Arc<Sampler>,
@@ -80,8 +81,8 @@ impl BlurChain {
         Ok(Self {
             pipeline: pipelines.compute("blur.comp", &[tap_count])?,
             narrow: [
-                pipelines.compute("blur_narrow.comp", &[0])?,
-                pipelines.compute("blur_narrow.comp", &[1])?,
+                pipelines.compute("blur_narrow.comp", &[Stencil::Three as u32])?,
+                pipelines.compute("blur_narrow.comp", &[Stencil::Five as u32])?,
             ],
             taps: upload_buffer(
                 ctx,

@@ -192,6 +192,25 @@ mod tests {
     }
 
     #[test]
+    fn narrow_levels_at_their_source_resolution_are_one_pass() {
+        // The scan at 1024² (1.62 texels/mm): σ increments of levels 2-4 are
+        // 0.36, 0.60 and 1.00 texels; 5 and 6 halve the resolution.
+        let stencils: Vec<Option<Stencil>> = plan(&Profile::skin(), Chain::Adaptive, 1024, 1.62)
+            .iter()
+            .map(|l| l.one_pass)
+            .collect();
+        use Stencil::*;
+        assert_eq!(
+            stencils,
+            [None, Some(Three), Some(Three), Some(Five), None, None]
+        );
+        // At 4096² (6.46 texels/mm) level 2 is 1.42 texels: two passes.
+        assert!(plan(&Profile::skin(), Chain::Adaptive, 4096, 6.46)
+            .iter()
+            .all(|l| l.one_pass.is_none()));
+    }
+
+    #[test]
     fn a_wide_first_gaussian_is_blurred() {
         // At 64 texels/mm σ1 = 0.08 mm spans 5 texels.
         let p = Profile::skin();
