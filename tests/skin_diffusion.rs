@@ -12,7 +12,7 @@ use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::scene::file::Chain;
 use dermis::scene::mesh::Mesh;
 use dermis::skin::blur::{BlurChain, BlurKernel};
-use dermis::skin::chain;
+use dermis::skin::chain::{self, Stencil};
 use dermis::skin::profile::{gaussian, Kernel, Profile};
 use dermis::skin::stretch::StretchMaps;
 use dermis::skin::{mean_stretch, UV_FORMAT};
@@ -258,8 +258,15 @@ fn sheared_plane(l: f32, cos: f32) -> (Mesh, [Vec2; 2]) {
 }
 
 /// One Gaussian of σ mm (the accurate kernel, taps spaced by the unblurred
-/// stretch map) on `input`; the N² result divided by its coverage.
-fn one_gaussian(mesh: &Mesh, input: &[[f32; 4]], sigma_mm: f32, shear: bool) -> Vec<Vec3> {
+/// stretch map; `one_pass`: the one-pass blur of a narrow Gaussian over that
+/// stencil) on `input`; the N² result divided by its coverage.
+fn one_gaussian(
+    mesh: &Mesh,
+    input: &[[f32; 4]],
+    sigma_mm: f32,
+    shear: bool,
+    one_pass: Option<Stencil>,
+) -> Vec<Vec3> {
     common::with_gpu(|ctx: &Arc<Context>| {
         let texels: Vec<f32> = input.iter().flatten().copied().collect();
         let bytes = common::to_f16_bytes(&texels);
@@ -279,7 +286,18 @@ fn one_gaussian(mesh: &Mesh, input: &[[f32; 4]], sigma_mm: f32, shear: bool) -> 
         );
         let st = stretch.pass(&mut g, &buffers, &blur);
         let mut dst = g.create_image("blurred", ImageDesc::new(N, N, UV_FORMAT));
-        blur.gaussian(&mut g, "blurred", &input, &st[0], sigma_mm, &mut dst);
+        if let Some(stencil) = one_pass {
+            blur.narrow(
+                &mut g,
+                "blurred",
+                (&input, &st[0]),
+                sigma_mm,
+                stencil,
+                &mut dst,
+            );
+        } else {
+            blur.gaussian(&mut g, "blurred", &input, &st[0], sigma_mm, &mut dst);
+        }
         readback.image_pass(&mut g, &dst);
         let mut ex = Executor::new(ctx, 1).unwrap();
         ex.run(g).unwrap();
@@ -329,11 +347,11 @@ fn shear_correction_makes_sheared_uvs_isotropic() {
     let variance = (sigma * sigma) as f64;
     let green = |out: Vec<Vec3>| out.iter().map(|c| c.y).collect::<Vec<f32>>();
     let on = surface_moments(
-        &green(one_gaussian(&mesh, &impulse(100.0), sigma, true)),
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, true, None)),
         jacobian,
     );
     let off = surface_moments(
-        &green(one_gaussian(&mesh, &impulse(100.0), sigma, false)),
+        &green(one_gaussian(&mesh, &impulse(100.0), sigma, false, None)),
         jacobian,
     );
     let report = |(major, minor, cross): (f64, f64, f64)| {
@@ -362,6 +380,39 @@ fn shear_correction_makes_sheared_uvs_isotropic() {
         "off should be anisotropic: {}",
         report(off)
     );
+}
+
+#[test]
+fn a_narrow_gaussian_in_one_pass_has_its_covariance() {
+    // σ of 0.3 and 0.7 texels along u over the 3×3 stencil, 0.7 and 1.0 over
+    // the 5×5 (skin::chain::Stencil), on a plain and a sheared plane (cos 0.6:
+    // at 0.3 texels its cross moment is beyond what the 3×3's symmetric tap
+    // pairs hold, at 1.0 its variance along u is past the 5×5's centre weight):
+    // the surface covariance is σ², isotropic, as the separable passes give
+    // for wide Gaussians.
+    let sigma = 0.6f32;
+    let variance = (sigma * sigma) as f64;
+    let green = |out: Vec<Vec3>| out.iter().map(|c| c.y).collect::<Vec<f32>>();
+    for (stencil, widths) in [(Stencil::Three, [0.3, 0.7]), (Stencil::Five, [0.7, 1.0])] {
+        for cos in [0.0, 0.6] {
+            for texels in widths {
+                let (mesh, jacobian) = sheared_plane(N as f32 * sigma / texels, cos);
+                let moments = |one_pass| {
+                    let out = one_gaussian(&mesh, &impulse(100.0), sigma, true, one_pass);
+                    let (major, minor, cross) = surface_moments(&green(out), jacobian);
+                    [major / variance, minor / variance, cross / variance]
+                };
+                let (one, two) = (moments(Some(stencil)), moments(None));
+                println!(
+                    "{stencil:?}, cos {cos}, σ = {texels} texels: eigen-variances / σ², \
+                     cross / σ²: one pass {one:.4?}, separable accurate kernel {two:.4?}"
+                );
+                assert!((one[0] - 1.0).abs() < 0.02, "{one:?}");
+                assert!((one[1] - 1.0).abs() < 0.02, "{one:?}");
+                assert!(one[2].abs() < 0.02, "{one:?}");
+            }
+        }
+    }
 }
 
 #[test]

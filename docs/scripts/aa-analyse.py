@@ -14,7 +14,7 @@ compares each pair's sides:
    frame, for N runs per side (the first N of each side), the share of pairs in
    which `dermis compare` calls PASS regressed.
 
-Usage: aa-analyse.py DIR [--pass blur3_u] [--runs 5,10] [--shifts 2,3,5,10,20]
+Usage: aa-analyse.py DIR [--pass blur3] [--runs 5,10] [--shifts 2,3,5,10,20]
 Needs only Python's standard library and the dermis binary (DERMIS, default
 target/release/dermis).
 """
@@ -63,7 +63,7 @@ def percentile(v, q):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dir")
-    ap.add_argument("--pass", dest="pass_", default="blur3_u")
+    ap.add_argument("--pass", dest="pass_", default="blur3")
     ap.add_argument("--runs", default="5,10")
     ap.add_argument("--shifts", default="2,3,5,10,20")
     args = ap.parse_args()

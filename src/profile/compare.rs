@@ -329,6 +329,9 @@ pub struct Comparison {
     pub passes: Vec<PassChange>,
     pub only_in_base: Vec<String>,
     pub only_in_new: Vec<String>,
+    /// Split passes joined to compare with one pass of the other side
+    /// ([`join_split_passes`]): "blur2 = blur2_u + blur2_v in BASE".
+    pub joined: Vec<String>,
 }
 
 impl Comparison {
@@ -347,6 +350,10 @@ impl Comparison {
 /// Compares `new` with `base`.
 pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> Result<Comparison> {
     check_options(opts)?;
+    let (mut base, mut new) = (base.clone(), new.clone());
+    let mut joined = join_split_passes(&mut base, &new);
+    joined.extend(join_split_passes(&mut new, &base));
+    let (base, new) = (&base, &new);
     let (mut warnings, setup_changes) = check_comparable(base, new, opts)?;
     let by_run = base.runs() >= 2 && new.runs() >= 2;
     if !by_run {
@@ -386,7 +393,38 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
         passes: rows,
         only_in_base,
         only_in_new,
+        joined,
     })
+}
+
+/// A pass `X` one side runs whole and the other as `X_u` then `X_v` (a blur
+/// level in one pass since issue 24, in two before): `side`'s two are joined,
+/// frame by frame, into one pass `X` in `X_u`'s place, counted at `X_v`'s
+/// texels (the level's), so the rows compare like with like. Returns what was
+/// joined.
+fn join_split_passes(side: &mut Measurement, other: &Measurement) -> Vec<String> {
+    let mut joined = Vec::new();
+    for name in &other.pass_order {
+        let (u, v) = (format!("{name}_u"), format!("{name}_v"));
+        let split = |m: &Measurement| m.pass_order.contains(&u) && m.pass_order.contains(&v);
+        if side.pass_order.contains(name) || !split(side) || split(other) {
+            continue;
+        }
+        for f in &mut side.frames {
+            if let (Some(a), Some(b)) = (f.passes.remove(&u), f.passes.remove(&v)) {
+                f.passes.insert(name.clone(), a + b);
+            }
+        }
+        side.pass_order.retain(|p| *p != v);
+        if let Some(p) = side.pass_order.iter_mut().find(|p| **p == u) {
+            *p = name.clone();
+        }
+        if let Some(t) = side.texels.get(&v).copied() {
+            side.texels.insert(name.clone(), t);
+        }
+        joined.push(format!("{name} = {u} + {v} in {}", side.source));
+    }
+    joined
 }
 
 /// The threshold and the level must be fractions.
@@ -756,6 +794,9 @@ pub fn table(c: &Comparison) -> String {
             s += &format!("only in {side}: {}\n", names.join(", "));
         }
     }
+    for j in &c.joined {
+        s += &format!("joined: {j}\n");
+    }
     s
 }
 
@@ -802,6 +843,39 @@ mod tests {
 
     fn row<'a>(c: &'a Comparison, name: &str) -> &'a PassChange {
         c.passes.iter().find(|p| p.name == name).unwrap()
+    }
+
+    #[test]
+    fn a_pass_split_in_two_on_one_side_is_joined() {
+        // base: blur_u + blur_v (1000 + 1000 × n); new: one pass blur.
+        let mut base = measurement(6, 3, |r, f| 1000.0 + 10.0 * noise(r * 3 + f), |_, _| 1.0);
+        base.pass_order = ["blur_u", "blur_v", "skin", RULER_COPY]
+            .map(String::from)
+            .into();
+        for f in &mut base.frames {
+            let t = f.passes.remove("blur").unwrap();
+            f.passes.insert("blur_u".into(), 1000.0);
+            f.passes.insert("blur_v".into(), t);
+        }
+        let new = measurement(
+            6,
+            3,
+            |r, f| 1000.0 + 10.0 * noise(r * 3 + f + 50),
+            |_, _| 1.0,
+        );
+        let c = compare(&base, &new, &CompareOptions::default()).unwrap();
+        assert!(
+            c.only_in_base.is_empty() && c.only_in_new.is_empty(),
+            "{c:?}"
+        );
+        assert_eq!(c.joined, ["blur = blur_u + blur_v in m"]);
+        let r = row(&c, "blur");
+        assert!(
+            (r.base_ms.unwrap() / r.new_ms.unwrap() - 2.0).abs() < 0.05,
+            "{r:?}"
+        );
+        assert_eq!(r.verdict, Verdict::Improved);
+        assert_eq!(c.passes[0].name, "blur");
     }
 
     #[test]

@@ -2,14 +2,16 @@
 //! Fig. 3): level k blurs level k−1 by σ_k = √(v_k − v_{k−1}) mm, separably (U then
 //! V), with taps spaced by the stretch map's level k−1 (skin::stretch). Levels
 //! may be coarser than their predecessor (skin::chain): the U pass then writes
-//! the new width, the V pass the new height.
+//! the new width, the V pass the new height. A level whose σ spans about a
+//! texel or less (chain::Stencil) is blurred in one pass, `blurK`, by a 3×3 or
+//! 5×5 stencil of its covariance (blur_narrow.comp), whichever kernel is chosen.
 //!
 //! Every UV target is coverage-premultiplied (alpha = 1 on the mesh, 0 in the
 //! gutter), so the chain is a plain linear convolution of (I·a, a) and dividing by
 //! alpha at lookup gives the convolution normalised over the mesh: blurs never
 //! pull the gutter's black into chart borders, however wide the kernel.
 
-use super::chain::Level;
+use super::chain::{Level, Stencil};
 use super::profile::Kernel;
 use super::UV_FORMAT;
 use crate::error::{Error, Result};
@@ -40,6 +42,9 @@ pub enum BlurKernel {
 
 pub struct BlurChain {
     pipeline: Arc<Pipeline>,
+    /// Both directions of a narrow Gaussian (blur_narrow.comp), indexed by
+    /// `Stencil as usize`, which is also the shader's FIVE constant.
+    narrow: [Arc<Pipeline>; 2],
     taps: Arc<Buffer>,
     sampler: Arc<Sampler>,
     /// The stretch maps hold the shear (skin.shear_correction): the V pass
@@ -75,6 +80,10 @@ impl BlurChain {
         };
         Ok(Self {
             pipeline: pipelines.compute("blur.comp", &[tap_count])?,
+            narrow: [
+                pipelines.compute("blur_narrow.comp", &[Stencil::Three as u32])?,
+                pipelines.compute("blur_narrow.comp", &[Stencil::Five as u32])?,
+            ],
             taps: upload_buffer(
                 ctx,
                 "blur kernel",
@@ -107,7 +116,11 @@ impl BlurChain {
             let desc = ImageDesc::new(level.resolution, level.resolution, UV_FORMAT);
             let mut dst = g.create_image(&name, desc);
             let src = out.last().unwrap_or(irradiance);
-            self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            if let Some(stencil) = level.one_pass {
+                self.narrow(g, &name, (src, &stretch[k]), sigma, stencil, &mut dst);
+            } else {
+                self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            }
             out.push(dst);
         }
         out
@@ -164,6 +177,27 @@ impl BlurChain {
         let u = format!("{name}_u");
         self.pass(g, &u, (src, stretch), &mut tmp, along([1, 0]));
         self.pass(g, &format!("{name}_v"), (&tmp, stretch), dst, along([0, 1]));
+    }
+
+    /// One narrow Gaussian of σ mm over `stencil`, both directions in one pass
+    /// `name`, from `src` into `dst` of the same size (blur_narrow.comp).
+    pub fn narrow(
+        &self,
+        g: &mut Graph,
+        name: &str,
+        (src, stretch): (&ImageHandle, &ImageHandle),
+        sigma_mm: f32,
+        stencil: Stencil,
+        dst: &mut ImageHandle,
+    ) {
+        let (w, h) = (dst.desc.width, dst.desc.height);
+        g.simple_pass(name, &self.narrow[stencil as usize])
+            .tag(super::TAG)
+            .sample(src, &self.sampler)
+            .sample(stretch, &self.sampler)
+            .store(dst)
+            .constants(&sigma_mm)
+            .dispatch([w, h, 1]);
     }
 
     fn pass(

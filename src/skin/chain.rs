@@ -5,6 +5,8 @@
 //! low-pass filter), and takes the unblurred irradiance for a first Gaussian
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
 //! first term). docs/performance.md shows what it costs and how far it is off.
+//! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
+//! of its source's resolution is blurred in one pass instead of two (issue 24).
 
 use super::profile::Profile;
 use crate::scene::file::Chain;
@@ -19,6 +21,36 @@ pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
 /// The coarsest level the adaptive chain goes down to.
 pub const MIN_RESOLUTION: u32 = 64;
+/// The texel neighbourhood of a level blurred in one pass (blur_narrow.comp),
+/// both directions at once, from a source of its own resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stencil {
+    /// 3×3, four bilinear taps: per axis the tent m/2, 1 − m, m/2 of variance
+    /// m = σ², highest at the centre up to m = 2/3.
+    Three,
+    /// 5×5, nine bilinear taps: per axis weights at 0, ±1, ±2 texels in the
+    /// Gaussian's ratio, with a centre weight up to m ≈ 1.9.
+    Five,
+}
+
+impl Stencil {
+    /// The largest σ increment, in texels at the mesh's mean stretch, this
+    /// stencil is used for (below the limits above, leaving room for a stretch
+    /// above the mean).
+    pub fn max_sigma_texels(self) -> f32 {
+        match self {
+            Stencil::Three => 0.8,
+            Stencil::Five => 1.2,
+        }
+    }
+
+    /// The smallest stencil for a blur of `sigma_texels`; `None`: two passes.
+    fn for_sigma(sigma_texels: f32) -> Option<Self> {
+        [Stencil::Three, Stencil::Five]
+            .into_iter()
+            .find(|s| sigma_texels <= s.max_sigma_texels())
+    }
+}
 
 /// One level of the chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +61,9 @@ pub struct Level {
     /// the level is the previous image, unblurred (an adaptive first level under
     /// [`SKIP_SIGMA_TEXELS`], or any level of a profile scaled to zero width).
     pub sigma_mm: Option<f32>,
+    /// The blur is narrow and keeps the previous image's resolution: one pass,
+    /// both directions, over this stencil (skin::blur); `None`: U then V.
+    pub one_pass: Option<Stencil>,
 }
 
 /// Plans the six levels. `texels_per_mm`: the stretch the adaptive choice is made
@@ -38,22 +73,16 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
     let (mut previous_variance, mut previous_resolution) = (0.0f32, resolution);
     for (k, g) in profile.gaussians.iter().enumerate() {
         let increment = (g.variance_mm2 - previous_variance).max(0.0).sqrt();
-        let level = match chain {
+        let (side, sigma_mm) = match chain {
             // `skin.blur_width = 0`: every level is the irradiance.
-            _ if increment == 0.0 => Level {
-                resolution: previous_resolution,
-                sigma_mm: None,
-            },
-            Chain::Full => Level {
-                resolution,
-                sigma_mm: Some(increment),
-            },
+            _ if increment == 0.0 => (previous_resolution, None),
+            Chain::Full => (resolution, Some(increment)),
             // The first, narrowest level keeps the full resolution (d'Eon & Luebke
             // §14.5): the irradiance itself when its blur is under SKIP_SIGMA_TEXELS.
-            Chain::Adaptive if k == 0 => Level {
+            Chain::Adaptive if k == 0 => (
                 resolution,
-                sigma_mm: (increment * texels_per_mm >= SKIP_SIGMA_TEXELS).then_some(increment),
-            },
+                (increment * texels_per_mm >= SKIP_SIGMA_TEXELS).then_some(increment),
+            ),
             Chain::Adaptive => {
                 let sigma = g.variance_mm2.sqrt();
                 let mut r = previous_resolution;
@@ -63,11 +92,16 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
                 {
                     r /= 2;
                 }
-                Level {
-                    resolution: r,
-                    sigma_mm: Some(increment),
-                }
+                (r, Some(increment))
             }
+        };
+        let texels = |sigma: f32| sigma * texels_per_mm * side as f32 / resolution as f32;
+        let level = Level {
+            resolution: side,
+            sigma_mm,
+            one_pass: sigma_mm
+                .filter(|_| side == previous_resolution)
+                .and_then(|s| Stencil::for_sigma(texels(s))),
         };
         if level.sigma_mm.is_some() {
             previous_variance = g.variance_mm2;
@@ -149,11 +183,31 @@ mod tests {
                     l,
                     Level {
                         resolution: 1024,
-                        sigma_mm: None
+                        sigma_mm: None,
+                        one_pass: None,
                     }
                 );
             }
         }
+    }
+
+    #[test]
+    fn narrow_levels_at_their_source_resolution_are_one_pass() {
+        // The scan at 1024² (1.62 texels/mm): σ increments of levels 2-4 are
+        // 0.36, 0.60 and 1.00 texels; 5 and 6 halve the resolution.
+        let stencils: Vec<Option<Stencil>> = plan(&Profile::skin(), Chain::Adaptive, 1024, 1.62)
+            .iter()
+            .map(|l| l.one_pass)
+            .collect();
+        use Stencil::*;
+        assert_eq!(
+            stencils,
+            [None, Some(Three), Some(Three), Some(Five), None, None]
+        );
+        // At 4096² (6.46 texels/mm) level 2 is 1.42 texels: two passes.
+        assert!(plan(&Profile::skin(), Chain::Adaptive, 4096, 6.46)
+            .iter()
+            .all(|l| l.one_pass.is_none()));
     }
 
     #[test]
