@@ -24,11 +24,10 @@ layout(location = 6) in vec3 v_t678;
 #define SPEC_REGIONS 7
 #define SPEC_INTENSITY 8
 #define SPEC_ROUGHNESS 9
-#define SPEC_HEMISPHERICAL 11
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #define SHADOW_ATLAS 10
-#define SOFT_VISIBILITY 12
+#define SOFT_VISIBILITY 11
 #include "lights.glsl"
 #define ENERGY_CONSERVING
 #include "lighting.glsl"

@@ -31,7 +31,6 @@ layout(binding = 12) uniform sampler2D blur6;
 #define SPEC_REGIONS 15
 #define SPEC_INTENSITY 16
 #define SPEC_ROUGHNESS 17
-#define SPEC_HEMISPHERICAL 22
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
@@ -114,13 +113,14 @@ void main() {
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
     // §14.3), taken from the diffuse and given to the environment's specular.
-    float reflected = params.x * specular_albedo(n_dot_v, params.y);
+    vec2 albedos = specular_albedos(n_dot_v, params.y);
+    float reflected = params.x * albedos.x;
     // What the oil layer reflects back inward on exit stays in the skin and
     // leaves later: the exit factor 1 − ρs·A(N·V) renormalised by its
     // hemispherical mean 1 − ρs·Ā(m), so that light entering leaves whole and a
     // white surface under a white sky reflects 1 (Kelemen & Szirmay-Kalos
     // 2001's coupled diffuse term; docs/skin.md, "White furnace").
-    float exit = (1.0 - reflected) / max(diffuse_transmission_uniform(params), 1e-3);
+    float exit = (1.0 - reflected) / max(1.0 - params.x * albedos.y, 1e-3);
     // The transmitted light enters with the pre-scatter albedo, as the
     // irradiance does (x's own albedo for the far side's).
     vec3 through = vec3(0.0);

@@ -2,7 +2,7 @@
 // §14.3, KS_Skin_Specular) with per-region parameters. Expects these bindings
 // (numbers set by the including shader through the SPEC_* macros):
 //   SPEC_BECKMANN  sampler2D  d'Eon's PH(N·H, m) = π·D, skin/tables.rs::beckmann_table
-//   SPEC_ALBEDO    sampler2D  A(cos θ, m), skin/specular.rs::specular_albedo_lut
+//   SPEC_ALBEDO    sampler2D  (A(cos θ, m), Ā(m)), skin/tables.rs::albedo_table
 //   SPEC_REGIONS   sampler2D  (ρs, m) blended from the face regions' parameters
 //                             (skin/specular.rs::region_params_map), nearest
 //   SPEC_INTENSITY sampler2D  the specular map s; ρs·(1 + SPEC_MAP_GAIN·min(s/(2s̄), 1))
@@ -46,9 +46,15 @@ float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
     return n_dot_l * params.x * max(d * f / dot(h, h), 0.0);
 }
 
+// (A(cos θ, m), Ā(m)) in one fetch: the specular's directional albedo and its
+// cosine-weighted mean over incidence (a row's constant second channel).
+vec2 specular_albedos(float cos_theta, float m) {
+    return texture(albedo_lut, table_uv(albedo_lut, vec2(cos_theta, m))).rg;
+}
+
 // Directional albedo of the KS lobe with ρs = 1, A(cos θ, m) (skin/specular.rs).
 float specular_albedo(float cos_theta, float m) {
-    return texture(albedo_lut, table_uv(albedo_lut, vec2(cos_theta, m))).r;
+    return specular_albedos(cos_theta, m).x;
 }
 
 // Energy conservation: the share of light at angle θ the specular does not take,
@@ -57,14 +63,9 @@ float diffuse_transmission(float cos_theta, vec2 params) {
     return max(1.0 - params.x * specular_albedo(cos_theta, params.y), 0.0);
 }
 
-#ifdef SPEC_HEMISPHERICAL
-layout(binding = SPEC_HEMISPHERICAL) uniform sampler2D hemispherical_lut;
-
 // The same for light arriving uniformly over the hemisphere, 1 − ρs·Ā(m) with
 // Ā = 2∫A(μ)μ dμ (skin/specular.rs::hemispherical_albedo): SH irradiance does
 // not keep incidence angles, so the environment is conserved as if uniform.
 float diffuse_transmission_uniform(vec2 params) {
-    vec2 uv = table_uv(hemispherical_lut, vec2(params.y, 0.0));
-    return max(1.0 - params.x * texture(hemispherical_lut, uv).r, 0.0);
+    return max(1.0 - params.x * specular_albedos(1.0, params.y).y, 0.0);
 }
-#endif

@@ -3,8 +3,7 @@
 // eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
 // explicit lights at x (geometric normal ng). Needs frame.glsl, sh.glsl,
 // lights.glsl, the Lighting buffer and v_t*.
-// With ENERGY_CONSERVING (and ks_specular.glsl with SPEC_HEMISPHERICAL),
-// each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
+// With ENERGY_CONSERVING (and ks_specular.glsl), each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
 // what the specular reflects does not enter the skin.
 vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {
     vec3 e;

@@ -54,8 +54,7 @@ impl IrradiancePass {
             .buffer(&inputs.transfer);
         let mut pass = tables
             .bind(pass, inputs)
-            .sample(shadows, &s.shadow)
-            .texture(&tables.hemispherical, &tables.sampler);
+            .sample(shadows, &s.shadow);
         for v in soft {
             pass = pass.sample(v, &s.linear);
         }

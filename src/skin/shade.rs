@@ -150,7 +150,7 @@ impl ShadePass {
         inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
         // specular environment, irradiance, six blur levels, the specular
-        // bindings, the soft lights' visibility, the atlas's depths, Ā(m).
+        // bindings, the soft lights' visibility, the atlas's depths.
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -169,7 +169,6 @@ impl ShadePass {
         }
         let pass = pass
             .sample(images.shadows, &s.nearest)
-            .texture(&tables.hemispherical, &tables.sampler)
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {

@@ -234,14 +234,6 @@ pub fn hemispherical_albedo(m: f32) -> f32 {
     (2.0 * sum / N as f64) as f32
 }
 
-/// [`hemispherical_albedo`] at `size` endpoint-inclusive roughnesses
-/// ([`table_point`]), the irradiance pass's table.
-pub fn hemispherical_albedo_lut(size: usize) -> Vec<f32> {
-    (0..size)
-        .map(|j| hemispherical_albedo(table_point(j, size)))
-        .collect()
-}
-
 /// erf by Abramowitz & Stegun 7.1.26 (|error| ≤ 1.5e-7).
 fn erf(x: f64) -> f64 {
     let t = 1.0 / (1.0 + 0.3275911 * x.abs());

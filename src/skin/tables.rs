@@ -18,8 +18,6 @@ use std::sync::Arc;
 pub const BECKMANN_SIZE: usize = 256;
 /// 64 × 64, as recommended by the ρdt accuracy tests (skin/specular.rs).
 pub const ALBEDO_SIZE: usize = 64;
-/// Roughnesses of the hemispherical-albedo table Ā(m) (smooth in m).
-pub const HEMISPHERICAL_SIZE: usize = 64;
 
 /// d'Eon's PH(N·H, m) = π·D (specular::beckmann_ph), endpoint-inclusive: row
 /// m = j/(n−1), column N·H = i/(n−1) (see `specular::table_point`). m = 0 is a
@@ -40,16 +38,27 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
         .collect()
 }
 
+/// The specular's directional albedo A(cos θ, m) (specular::specular_albedo_lut,
+/// n × n) with its cosine-weighted mean over incidence Ā(m)
+/// (specular::hemispherical_albedo: what the environment's SH irradiance, whose
+/// incidence angles are lost, gives the specular) beside it in every texel of a
+/// row: interleaved (A, Ā), so the final pass reads both in one fetch.
+pub fn albedo_table(n: usize) -> Vec<f32> {
+    let a = specular::specular_albedo_lut(n, n, 256, 64);
+    let mean: Vec<f32> = (0..n)
+        .map(|j| specular::hemispherical_albedo(specular::table_point(j, n)))
+        .collect();
+    a.iter().enumerate().flat_map(|(k, &a)| [a, mean[k / n]]).collect()
+}
+
 pub struct SpecularTables {
     pub beckmann: Arc<Image>,
+    /// [`albedo_table`]: (A(cos θ, m), Ā(m)), RG32F.
     pub albedo: Arc<Image>,
-    /// Ā(m), the cosine-weighted mean of A over incidence (specular::hemispherical_albedo),
-    /// for the environment's energy conservation on entry; 64 × 1.
-    pub hemispherical: Arc<Image>,
     /// (ρs, m) per region-map texel, blended across region borders
     /// (specular::region_params_map), RGBA16F.
     pub params: Arc<Image>,
-    /// Linear where the device filters R32F, else nearest.
+    /// Linear where the device filters R32F and RG32F, else nearest.
     pub sampler: Arc<Sampler>,
 }
 
@@ -61,8 +70,8 @@ impl SpecularTables {
         linear: Arc<Sampler>,
         nearest: Arc<Sampler>,
     ) -> Result<Self> {
-        let table = |name: &str, (w, h): (usize, usize), values: Vec<f32>| {
-            let desc = ImageDesc::new(w as u32, h as u32, vk::Format::R32_SFLOAT);
+        let table = |name: &str, (w, h): (usize, usize), format, values: Vec<f32>| {
+            let desc = ImageDesc::new(w as u32, h as u32, format);
             upload_texture(ctx, name, desc, bytemuck::cast_slice(&values))
         };
         let params: Vec<[f32; 2]> = (0..REGION_COUNT)
@@ -84,17 +93,14 @@ impl SpecularTables {
             beckmann: table(
                 "beckmann table",
                 (BECKMANN_SIZE, BECKMANN_SIZE),
+                vk::Format::R32_SFLOAT,
                 beckmann_table(BECKMANN_SIZE),
             )?,
             albedo: table(
                 "specular albedo table",
                 (ALBEDO_SIZE, ALBEDO_SIZE),
-                specular::specular_albedo_lut(ALBEDO_SIZE, ALBEDO_SIZE, 256, 64),
-            )?,
-            hemispherical: table(
-                "hemispherical albedo table",
-                (HEMISPHERICAL_SIZE, 1),
-                specular::hemispherical_albedo_lut(HEMISPHERICAL_SIZE),
+                vk::Format::R32G32_SFLOAT,
+                albedo_table(ALBEDO_SIZE),
             )?,
             params: upload_texture(
                 ctx,
@@ -102,7 +108,9 @@ impl SpecularTables {
                 ImageDesc::new(w, h, vk::Format::R16G16B16A16_SFLOAT),
                 &map,
             )?,
-            sampler: if ctx.supports_linear_filter(vk::Format::R32_SFLOAT) {
+            sampler: if ctx.supports_linear_filter(vk::Format::R32_SFLOAT)
+                && ctx.supports_linear_filter(vk::Format::R32G32_SFLOAT)
+            {
                 linear
             } else {
                 nearest
@@ -119,5 +127,23 @@ impl SpecularTables {
             .texture(&self.params, &s.nearest)
             .texture(&inputs.specular, &s.linear)
             .texture(&inputs.roughness, &s.linear)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_albedo_table_holds_a_and_its_mean_per_row() {
+        let n = 8;
+        let t = albedo_table(n);
+        let a = specular::specular_albedo_lut(n, n, 256, 64);
+        assert_eq!(t.len(), 2 * n * n);
+        for (k, pair) in t.chunks_exact(2).enumerate() {
+            assert_eq!(pair[0], a[k]);
+            let m = specular::table_point(k / n, n);
+            assert_eq!(pair[1], specular::hemispherical_albedo(m), "texel {k}");
+        }
     }
 }
