@@ -38,7 +38,6 @@ pub struct ShadowMaps {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Focus {
     pub view: ShadowView,
-    pub centre: Vec2,
     /// Half the side (1: the whole map).
     pub half: f32,
     /// The depth of the nearest vertex in the window: no blocker of its soft
@@ -113,7 +112,6 @@ impl Focus {
                 texel_mm: whole.texel_mm * half,
                 ..*whole
             },
-            centre,
             half,
             nearest,
         }

@@ -119,6 +119,25 @@ fn frame_uniforms(
     u
 }
 
+/// Each shadowed light's texel size, mm (a point light's at its near plane),
+/// in its focus map and in its whole-mesh map.
+fn log_shadow_maps(lighting: &Lighting) {
+    for (i, m) in lighting.maps.iter().enumerate() {
+        let Some(m) = m else { continue };
+        let texel = |v: &ShadowView| v.texel_mm * v.near_mm.unwrap_or(1.0);
+        match m.focus {
+            Some(f) => log::info!(
+                "light {i}: shadow map {:.3} mm a texel where the camera looks \
+                 ({:.1}× finer), {:.3} mm elsewhere",
+                texel(&f.view),
+                1.0 / f.half,
+                texel(&m.whole)
+            ),
+            None => log::info!("light {i}: shadow map {:.3} mm a texel", texel(&m.whole)),
+        }
+    }
+}
+
 /// The scene uploaded for the frame's passes, lit by `lighting`.
 fn frame_inputs(
     ctx: &Arc<Context>,
@@ -297,20 +316,7 @@ impl Frame {
             .map_or(0.0, |g| g.variance_mm2);
         let margin_mm = 4.0 * widest.sqrt();
         let lighting = Lighting::resolve(scene, extraction.lights.clone(), margin_mm);
-        for (i, m) in lighting.maps.iter().enumerate() {
-            let Some(m) = m else { continue };
-            let texel = |v: &ShadowView| v.texel_mm * v.near_mm.unwrap_or(1.0);
-            match m.focus {
-                Some(f) => log::info!(
-                    "light {i}: shadow map {:.3} mm a texel where the camera looks \
-                     ({:.1}× finer), {:.3} mm elsewhere",
-                    texel(&f.view),
-                    1.0 / f.half,
-                    texel(&m.whole)
-                ),
-                None => log::info!("light {i}: shadow map {:.3} mm a texel", texel(&m.whole)),
-            }
-        }
+        log_shadow_maps(&lighting);
         let tiles = lighting.tiles().len();
         let (cols, rows) = atlas_grid(tiles);
         let res = lighting.shadow_resolution;

@@ -52,9 +52,7 @@ impl IrradiancePass {
             .texture(&inputs.normal, &s.linear)
             .read_uniform(sh)
             .buffer(&inputs.transfer);
-        let mut pass = tables
-            .bind(pass, inputs)
-            .sample(shadows, &s.shadow);
+        let mut pass = tables.bind(pass, inputs).sample(shadows, &s.shadow);
         for v in soft {
             pass = pass.sample(v, &s.linear);
         }

@@ -48,7 +48,10 @@ pub fn albedo_table(n: usize) -> Vec<f32> {
     let mean: Vec<f32> = (0..n)
         .map(|j| specular::hemispherical_albedo(specular::table_point(j, n)))
         .collect();
-    a.iter().enumerate().flat_map(|(k, &a)| [a, mean[k / n]]).collect()
+    a.iter()
+        .enumerate()
+        .flat_map(|(k, &a)| [a, mean[k / n]])
+        .collect()
 }
 
 pub struct SpecularTables {
