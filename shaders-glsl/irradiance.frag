@@ -19,6 +19,9 @@ layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
+// The light the skin reflects onto itself (uv_lit.vert; lighting.glsl).
+layout(location = 7) in vec3 v_bounce;
+#define INTERREFLECTION
 #define SPEC_BECKMANN 5
 #define SPEC_ALBEDO 6
 #define SPEC_REGIONS 7

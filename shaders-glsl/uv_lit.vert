@@ -1,7 +1,16 @@
 #version 460
-// uv.vert plus the vertex's SH transfer, for the irradiance pass.
+// uv.vert plus the vertex's SH transfer, for the irradiance pass, and the light
+// the skin reflects onto the vertex (light/interreflection.rs): the
+// interreflected transfer applied to the environment's SH and to the explicit
+// lights projected into SH here (a directional light of irradiance E from l is
+// the radiance E·δ(ω − l), coefficients E·y_j(l); a point light's seen from
+// the vertex), zero without interreflection.
 #extension GL_GOOGLE_include_directive : require
+#include "frame.glsl"
+#include "sh.glsl"
+#define BOUNCE 14
 #include "transfer.glsl"
+layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 position;   // mm
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
@@ -13,6 +22,9 @@ layout(location = 3) out vec4 v_tangent;
 layout(location = 4) out vec3 v_t012;
 layout(location = 5) out vec3 v_t345;
 layout(location = 6) out vec3 v_t678;
+layout(location = 7) out vec3 v_bounce;
+
+const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 
 void main() {
     v_position = position;
@@ -20,5 +32,22 @@ void main() {
     v_uv = uv;
     v_tangent = tangent;
     load_transfer(v_t012, v_t345, v_t678);
+    vec3 L[9];
+    for (int j = 0; j < 9; ++j) L[j] = lighting.sh[j].rgb;
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
+        vec4 lv = frame.light_vec[i];
+        vec3 e = frame.light_color[i].rgb;
+        vec3 l = lv.xyz;
+        if (lv.w > 0.5) {
+            vec3 d = lv.xyz - position;
+            float d2 = max(dot(d, d), 1e-6);
+            l = d * inversesqrt(d2);
+            e *= POINT_REFERENCE_MM * POINT_REFERENCE_MM / d2;
+        }
+        float y[9];
+        sh_basis(l, y);
+        for (int j = 0; j < 9; ++j) L[j] += e * y[j];
+    }
+    v_bounce = OCCLUSION ? bounce_irradiance(L) : vec3(0.0);
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
 }

@@ -257,12 +257,17 @@ fn texture_space_diffusion_leaves_no_seam_lines() {
 }
 
 /// Mean red irradiance per face region of the built-in head (UV-space view),
-/// under a uniform red environment (the paper's Fig. 6).
-fn region_irradiance(occlusion: dermis::scene::file::Occlusion) -> [f32; 10] {
+/// under a uniform red environment (the paper's Fig. 6), with or without the
+/// light the skin reflects onto itself.
+fn region_irradiance(
+    occlusion: dermis::scene::file::Occlusion,
+    interreflection: bool,
+) -> [f32; 10] {
     use dermis::render::View;
     let mut file = SceneFile::default();
     file.environment.source = "uniform:1,0,0".parse().unwrap();
     file.skin.occlusion = occlusion;
+    file.skin.interreflection = interreflection;
     file.render.irradiance_resolution = 512;
     file.render.width = 64;
     file.render.height = 64;
@@ -303,8 +308,8 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
     use dermis::scene::head::{
         REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES, REGION_NOSE,
     };
-    let on = region_irradiance(Occlusion::Raytrace);
-    let off = region_irradiance(Occlusion::Off);
+    let on = region_irradiance(Occlusion::Raytrace, false);
+    let off = region_irradiance(Occlusion::Off, false);
     for i in 0..10 {
         println!(
             "{:<14} on {:.3} off {:.3} ratio {:.3}",
@@ -330,6 +335,44 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
     assert!(
         ratio(REGION_FOREHEAD) > ratio(REGION_EYES) + 0.1,
         "the open forehead stays brighter"
+    );
+}
+
+/// The light the skin reflects onto itself (light::interreflection) adds to
+/// every region, most where the sky is most occluded: the eye sockets and
+/// the ears gain more than the open forehead. Under a red sky on the
+/// built-in head's skin (red albedo ≈ 0.6) a crease that sees skin over a
+/// third of its hemisphere gains ≳ 0.6·⅓ of what the sky gives it.
+#[test]
+fn interreflection_brightens_the_concavities_most() {
+    use dermis::scene::file::Occlusion;
+    use dermis::scene::head::{REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES};
+    let on = region_irradiance(Occlusion::Raytrace, true);
+    let off = region_irradiance(Occlusion::Raytrace, false);
+    for i in 0..10 {
+        println!(
+            "{:<14} bounce on {:.3} off {:.3} ratio {:.3}",
+            REGION_NAMES[i],
+            on[i],
+            off[i],
+            on[i] / off[i]
+        );
+    }
+    let gain = |r: u8| on[r as usize] / off[r as usize];
+    for i in 0..10u8 {
+        assert!(gain(i) >= 1.0, "{}: {}", REGION_NAMES[i as usize], gain(i));
+    }
+    assert!(
+        gain(REGION_EYES) > 1.05,
+        "eye sockets: {}",
+        gain(REGION_EYES)
+    );
+    assert!(gain(REGION_EARS) > 1.03, "ears: {}", gain(REGION_EARS));
+    assert!(
+        gain(REGION_FOREHEAD) < gain(REGION_EYES) - 0.03,
+        "the open forehead gains less: {} vs {}",
+        gain(REGION_FOREHEAD),
+        gain(REGION_EYES)
     );
 }
 

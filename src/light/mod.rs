@@ -4,6 +4,7 @@
 
 pub mod direct;
 pub mod extract;
+pub mod interreflection;
 pub mod lighting;
 pub mod occlusion;
 pub mod prefilter;

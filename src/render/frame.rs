@@ -16,6 +16,7 @@ use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle};
 use crate::light::direct::DirectPass;
 use crate::light::extract::extract;
+use crate::light::interreflection;
 use crate::light::lighting::Lighting;
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
@@ -156,8 +157,14 @@ fn frame_inputs(
             .filter(|&i| has(i))
             .fold(0, |b, i| b | 1 << i)
     };
-    let transfer =
-        crate::light::occlusion::transfer_for(ctx, &scene.mesh, scene.file.skin.occlusion)?;
+    let occlusion = scene.file.skin.occlusion;
+    let transfer = crate::light::occlusion::transfer_for(ctx, &scene.mesh, occlusion)?;
+    let bounce = match crate::light::occlusion::transfer_key(&scene.mesh, occlusion) {
+        Some(key) if scene.file.skin.interreflection => {
+            interreflection::bounce_for(&scene.mesh, albedo, &transfer, &key)
+        }
+        _ => interreflection::Bounce::none(scene.mesh.vertex_count()),
+    };
     Ok(FrameInputs {
         uniforms: upload_buffer(
             ctx,
@@ -172,6 +179,12 @@ fn frame_inputs(
             ctx,
             "transfer",
             bytemuck::cast_slice(&transfer.coeffs),
+            Access::ShaderBufferRead,
+        )?,
+        bounce: upload_buffer(
+            ctx,
+            "interreflected transfer",
+            bytemuck::cast_slice(&bounce.coeffs),
             Access::ShaderBufferRead,
         )?,
         specular: upload_rgba8(ctx, "specular map", &scene.specular)?,

@@ -170,6 +170,10 @@ overrides! {
     /// Per-vertex occlusion (default: the scene's, raytrace).
     #[arg(value_enum)]
     occlusion: Occlusion => skin.occlusion, example "raster";
+    /// Light the skin reflects onto itself (interreflected transfer), replacing
+    /// `skin.interreflection`.
+    #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
+    interreflection: bool => skin.interreflection, example "off";
     /// Blur kernel of the diffusion chain, replacing the scene's `skin.kernel`.
     #[arg(value_enum)]
     kernel: Kernel => skin.kernel, example "accurate";

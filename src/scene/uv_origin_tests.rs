@@ -10,7 +10,7 @@ use glam::{Vec2, Vec3};
 
 use super::file::{load_scene, UvOrigin};
 use super::mesh::Mesh;
-use super::texture::Texture;
+use super::texture::{srgb_to_linear, Texture};
 use super::{Overrides, Scene};
 
 const SCENES: [&str; 2] = [
@@ -28,16 +28,6 @@ fn scan_scene(origin: UvOrigin) -> Scene {
         ..Overrides::default()
     };
     Scene::load(overrides.apply(file).unwrap()).unwrap()
-}
-
-/// IEC 61966-2-1 sRGB decoding of one 8-bit value.
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = f32::from(c) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// RGB of an RGBA8 texture as floats, `decode` applied per channel.

@@ -28,6 +28,7 @@ mod transfer;
 
 pub use bvh::{Bvh, Hit};
 pub use cache::{cache_key, default_cache_dir, load_cached, store_cached};
+pub(crate) use raytrace::directions;
 pub use raytrace::{raytrace, RayOptions};
 pub use transfer::{unoccluded, Transfer};
 
@@ -39,13 +40,26 @@ use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
 use raster::RasterOptions;
 
+/// `mode`'s method name and cache settings; `None` for `Off` (computed, never cached).
+fn method(mode: Occlusion) -> Option<(&'static str, String)> {
+    match mode {
+        Occlusion::Off => None,
+        Occlusion::Raytrace => Some(("raytrace", RayOptions::default().cache_settings())),
+        Occlusion::Raster => Some(("raster", RasterOptions::default().cache_settings())),
+    }
+}
+
+/// The cache key of `mode`'s transfer of `mesh` (the mesh, the method and its
+/// settings); `None` for `Off`.
+pub fn transfer_key(mesh: &Mesh, mode: Occlusion) -> Option<String> {
+    method(mode).map(|(method, settings)| cache_key(mesh, method, &settings))
+}
+
 /// The per-vertex SH transfer for `mode` (unoccluded for `Off`), from the disk
-/// cache when it holds it (keyed by the mesh, the method and its settings).
+/// cache when it holds it ([`transfer_key`]).
 pub fn transfer_for(ctx: &Arc<Context>, mesh: &Mesh, mode: Occlusion) -> Result<Transfer> {
-    let (method, settings) = match mode {
-        Occlusion::Off => return Ok(unoccluded(mesh)),
-        Occlusion::Raytrace => ("raytrace", RayOptions::default().cache_settings()),
-        Occlusion::Raster => ("raster", RasterOptions::default().cache_settings()),
+    let Some((method, settings)) = method(mode) else {
+        return Ok(unoccluded(mesh));
     };
     let key = cache_key(mesh, method, &settings);
     let dir = default_cache_dir();

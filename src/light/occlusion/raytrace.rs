@@ -118,7 +118,7 @@ fn cosine_sample(k: u32, n: u32, shift: (f32, f32)) -> Vec3 {
 }
 
 /// The `n` world-space directions used for a vertex with unit normal `nrm`.
-fn directions(nrm: Vec3, n: u32, seed: u32, index: u32) -> impl Iterator<Item = Vec3> {
+pub(crate) fn directions(nrm: Vec3, n: u32, seed: u32, index: u32) -> impl Iterator<Item = Vec3> {
     let (b1, b2) = nrm.any_orthonormal_pair();
     let shift = vertex_shift(seed, index);
     (0..n).map(move |k| {

@@ -1,4 +1,4 @@
-//! `[skin]`: kernel, chain, occlusion, profile, regions, blur, transmission.
+//! `[skin]`: kernel, chain, occlusion, interreflection, profile, regions, blur, transmission.
 
 use serde::{Deserialize, Serialize};
 
@@ -77,6 +77,9 @@ pub struct Skin {
     /// (skin::specular).
     pub regions: Option<Vec<SpecularRegion>>,
     pub occlusion: Occlusion,
+    /// Light the skin reflects onto itself (Sloan et al. 2002's interreflected
+    /// transfer, light::interreflection), with every occlusion but `off`.
+    pub interreflection: bool,
     /// Correct blur widths for UV distortion with the stretch map (the paper's
     /// section II.B); off: one texels-per-mm constant for the whole mesh.
     pub stretch_correction: bool,
@@ -106,6 +109,7 @@ impl Default for Skin {
             profile: None,
             regions: None,
             occlusion: Occlusion::Raytrace,
+            interreflection: true,
             stretch_correction: true,
             shear_correction: true,
             blur_width: 1.0,
