@@ -178,18 +178,24 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
 /// `dermis precompute`.
 pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Result<()> {
     let file = args.scene.load(&args.overrides)?;
-    let mesh = dermis::scene::load_mesh(&file)?;
+    let scene = dermis::scene::Scene::load(file)?;
+    let (mesh, skin) = (&scene.mesh, &scene.file.skin);
     let ctx = Context::new(context)?;
     let started = std::time::Instant::now();
-    let t = dermis::light::occlusion::transfer_for(&ctx, &mesh, file.skin.occlusion)?;
+    let t = dermis::light::occlusion::transfer_for(&ctx, mesh, skin.occlusion)?;
     let secs = started.elapsed().as_secs_f64();
     println!(
         "{} vertices, occlusion {:?}: {:.2} s ({:.1} µs per vertex), cache {}",
         t.coeffs.len(),
-        file.skin.occlusion,
+        skin.occlusion,
         secs,
         secs * 1e6 / t.coeffs.len().max(1) as f64,
         dermis::light::occlusion::default_cache_dir().display()
     );
+    if skin.interreflection {
+        let started = std::time::Instant::now();
+        dermis::light::interreflection::bounce_for(mesh, &scene.albedo, &t, skin.occlusion);
+        println!("interreflection: {:.2} s", started.elapsed().as_secs_f64());
+    }
     Ok(())
 }

@@ -32,7 +32,8 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::occlusion::{cache_key, default_cache_dir, load_cached, store_cached};
-use super::occlusion::{directions, Bvh, RayOptions, Transfer};
+use super::occlusion::{directions, transfer_key, Bvh, RayOptions, Transfer};
+use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
 use crate::scene::texture::Texture;
 
@@ -191,10 +192,14 @@ fn albedo_hash(albedo: &Texture) -> u64 {
     h
 }
 
-/// [`interreflect`] with the default rays, from the disk cache when it holds
-/// it (keyed by the mesh, the direct transfer's key `direct_key`, the albedo
-/// map and the settings).
-pub fn bounce_for(mesh: &Mesh, albedo: &Texture, direct: &Transfer, direct_key: &str) -> Bounce {
+/// [`interreflect`] with the default rays for the direct transfer `direct` of
+/// occlusion `mode` (none for `Off`), from the disk cache when it holds it
+/// (keyed by the mesh, the direct transfer's key, the albedo map and the
+/// settings).
+pub fn bounce_for(mesh: &Mesh, albedo: &Texture, direct: &Transfer, mode: Occlusion) -> Bounce {
+    let Some(direct_key) = transfer_key(mesh, mode) else {
+        return Bounce::none(mesh.vertex_count());
+    };
     let opts = RayOptions {
         // Other directions than the direct transfer's: independent noise.
         seed: 1,

@@ -159,11 +159,10 @@ fn frame_inputs(
     };
     let occlusion = scene.file.skin.occlusion;
     let transfer = crate::light::occlusion::transfer_for(ctx, &scene.mesh, occlusion)?;
-    let bounce = match crate::light::occlusion::transfer_key(&scene.mesh, occlusion) {
-        Some(key) if scene.file.skin.interreflection => {
-            interreflection::bounce_for(&scene.mesh, albedo, &transfer, &key)
-        }
-        _ => interreflection::Bounce::none(scene.mesh.vertex_count()),
+    let bounce = if scene.file.skin.interreflection {
+        interreflection::bounce_for(&scene.mesh, albedo, &transfer, occlusion)
+    } else {
+        interreflection::Bounce::none(scene.mesh.vertex_count())
     };
     Ok(FrameInputs {
         uniforms: upload_buffer(
