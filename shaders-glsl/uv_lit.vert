@@ -4,11 +4,12 @@
 // interreflected transfer applied to the environment's SH and to the explicit
 // lights projected into SH here (a directional light of irradiance E from l is
 // the radiance E·δ(ω − l), coefficients E·y_j(l); a point light's seen from
-// the vertex), zero without interreflection.
+// the vertex), plus the environment's light through thin skin
+// (light/transmission.rs; the lights' is the final pass's), zero without them.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "sh.glsl"
-#define BOUNCE 14
+#define RGB_TRANSFER 14
 #include "transfer.glsl"
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 position;   // mm
@@ -34,6 +35,7 @@ void main() {
     load_transfer(v_t012, v_t345, v_t678);
     vec3 L[9];
     for (int j = 0; j < 9; ++j) L[j] = lighting.sh[j].rgb;
+    vec3 through = rgb_transfer_irradiance(TRANSMITTED, L);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec4 lv = frame.light_vec[i];
         vec3 e = frame.light_color[i].rgb;
@@ -48,6 +50,6 @@ void main() {
         sh_basis(l, y);
         for (int j = 0; j < 9; ++j) L[j] += e * y[j];
     }
-    v_bounce = OCCLUSION ? bounce_irradiance(L) : vec3(0.0);
+    v_bounce = OCCLUSION ? rgb_transfer_irradiance(INTERREFLECTED, L) + through : vec3(0.0);
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
 }

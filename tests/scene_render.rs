@@ -258,16 +258,19 @@ fn texture_space_diffusion_leaves_no_seam_lines() {
 
 /// Mean red irradiance per face region of the built-in head (UV-space view),
 /// under a uniform red environment (the paper's Fig. 6), with or without the
-/// light the skin reflects onto itself.
+/// light the skin reflects onto itself and the sky's light through thin skin
+/// (`transmission`: skin.transmission).
 fn region_irradiance(
     occlusion: dermis::scene::file::Occlusion,
     interreflection: bool,
+    transmission: f32,
 ) -> [f32; 10] {
     use dermis::render::View;
     let mut file = SceneFile::default();
     file.environment.source = "uniform:1,0,0".parse().unwrap();
     file.skin.occlusion = occlusion;
     file.skin.interreflection = interreflection;
+    file.skin.transmission = transmission;
     file.render.irradiance_resolution = 512;
     file.render.width = 64;
     file.render.height = 64;
@@ -308,8 +311,8 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
     use dermis::scene::head::{
         REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES, REGION_NOSE,
     };
-    let on = region_irradiance(Occlusion::Raytrace, false);
-    let off = region_irradiance(Occlusion::Off, false);
+    let on = region_irradiance(Occlusion::Raytrace, false, 0.0);
+    let off = region_irradiance(Occlusion::Off, false, 0.0);
     for i in 0..10 {
         println!(
             "{:<14} on {:.3} off {:.3} ratio {:.3}",
@@ -347,8 +350,8 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
 fn interreflection_brightens_the_concavities_most() {
     use dermis::scene::file::Occlusion;
     use dermis::scene::head::{REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES};
-    let on = region_irradiance(Occlusion::Raytrace, true);
-    let off = region_irradiance(Occlusion::Raytrace, false);
+    let on = region_irradiance(Occlusion::Raytrace, true, 0.0);
+    let off = region_irradiance(Occlusion::Raytrace, false, 0.0);
     for i in 0..10 {
         println!(
             "{:<14} bounce on {:.3} off {:.3} ratio {:.3}",
@@ -374,6 +377,38 @@ fn interreflection_brightens_the_concavities_most() {
         gain(REGION_FOREHEAD),
         gain(REGION_EYES)
     );
+}
+
+/// The sky's light through thin skin (light::transmission) reaches the ears
+/// and nothing thick: the forehead and cheeks are unchanged.
+#[test]
+fn the_sky_shines_through_the_ears_only() {
+    use dermis::scene::file::Occlusion;
+    use dermis::scene::head::{
+        REGION_EARS, REGION_FOREHEAD, REGION_LEFT_CHEEK, REGION_NAMES, REGION_RIGHT_CHEEK,
+    };
+    let on = region_irradiance(Occlusion::Raytrace, false, 1.0);
+    let off = region_irradiance(Occlusion::Raytrace, false, 0.0);
+    for i in 0..10 {
+        println!(
+            "{:<14} transmitted on {:.3} off {:.3} ratio {:.4}",
+            REGION_NAMES[i],
+            on[i],
+            off[i],
+            on[i] / off[i]
+        );
+    }
+    // Measured: ears +0.4 %, nose (nostrils) +0.4 %, forehead and cheeks 0.
+    let gain = |r: u8| on[r as usize] / off[r as usize];
+    assert!(gain(REGION_EARS) > 1.002, "ears: {}", gain(REGION_EARS));
+    for r in [REGION_FOREHEAD, REGION_LEFT_CHEEK, REGION_RIGHT_CHEEK] {
+        assert!(
+            (gain(r) - 1.0).abs() < 1e-4,
+            "{}: {}",
+            REGION_NAMES[r as usize],
+            gain(r)
+        );
+    }
 }
 
 #[test]

@@ -9,17 +9,20 @@ void load_transfer(out vec3 t012, out vec3 t345, out vec3 t678) {
     t678 = vec3(transfer[b + 6u], transfer[b + 7u], transfer[b + 8u]);
 }
 
-#ifdef BOUNCE
-// The interreflected transfer (light/interreflection.rs): nine coefficients per
-// channel per vertex, R then G then B.
-layout(std430, binding = BOUNCE) readonly buffer Bounce { float bounce[]; };
+#ifdef RGB_TRANSFER
+// Per vertex the interreflected transfer (light/interreflection.rs) and the
+// environment's transmitted one (light/transmission.rs): nine coefficients per
+// channel each, R then G then B.
+layout(std430, binding = RGB_TRANSFER) readonly buffer RgbTransfer { float rgb_transfer[]; };
+const uint INTERREFLECTED = 0u;
+const uint TRANSMITTED = 27u;
 
-// Irradiance the skin reflects onto this vertex under SH radiance L (rgb).
-vec3 bounce_irradiance(vec3 L[9]) {
-    uint b = uint(gl_VertexIndex) * 27u;
+// Irradiance under SH radiance L (rgb) through this vertex's transfer `which`.
+vec3 rgb_transfer_irradiance(uint which, vec3 L[9]) {
+    uint b = uint(gl_VertexIndex) * 54u + which;
     vec3 e = vec3(0.0);
     for (uint j = 0u; j < 9u; ++j) {
-        e += L[j] * vec3(bounce[b + j], bounce[b + 9u + j], bounce[b + 18u + j]);
+        e += L[j] * vec3(rgb_transfer[b + j], rgb_transfer[b + 9u + j], rgb_transfer[b + 18u + j]);
     }
     return e;
 }

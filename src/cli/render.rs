@@ -197,5 +197,18 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
         dermis::light::interreflection::bounce_for(mesh, &scene.albedo, &t, skin.occlusion);
         println!("interreflection: {:.2} s", started.elapsed().as_secs_f64());
     }
+    let settings = dermis::skin::SkinSettings::resolve(skin, &scene.file.render)?;
+    let started = std::time::Instant::now();
+    dermis::light::transmission::transmitted_for(
+        mesh,
+        &t,
+        skin.occlusion,
+        &settings.profile,
+        settings.transmission,
+    );
+    println!(
+        "environment transmission: {:.2} s",
+        started.elapsed().as_secs_f64()
+    );
     Ok(())
 }

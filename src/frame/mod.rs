@@ -27,9 +27,10 @@ pub struct FrameInputs {
     pub normal: Arc<Image>,
     /// Per-vertex SH transfer, 9 floats per vertex (light::occlusion).
     pub transfer: Arc<Buffer>,
-    /// Per-vertex interreflected transfer, 27 floats per vertex (9 per
-    /// channel, R, G, B; light::interreflection), zeros without it.
-    pub bounce: Arc<Buffer>,
+    /// Per vertex the interreflected transfer (light::interreflection) and the
+    /// environment's transmitted one (light::transmission), each 9 floats per
+    /// channel (R, G, B): 54 floats, zeros where a term is off.
+    pub rgb_transfer: Arc<Buffer>,
     /// Specular intensity and roughness maps (read by the specular term; the face
     /// regions reach it blended, skin::tables).
     pub specular: Arc<Image>,

@@ -31,8 +31,8 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::occlusion::{cache_key, default_cache_dir, load_cached, store_cached};
-use super::occlusion::{directions, transfer_key, Bvh, RayOptions, Transfer};
+use super::occlusion::{cache_key, rgb_cached};
+use super::occlusion::{directions, transfer_key, Bvh, RayOptions, RgbTransfer, Transfer};
 use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
 use crate::scene::texture::Texture;
@@ -44,21 +44,6 @@ use crate::scene::texture::Texture;
 const TOLERANCE: f32 = 1e-4;
 /// The most bounces summed (q ≤ 0.98 converges within it).
 const MAX_BOUNCES: u32 = 500;
-
-/// Per-vertex interreflected transfer: nine coefficients per channel (R, G, B).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Bounce {
-    pub coeffs: Vec<[[f32; 9]; 3]>,
-}
-
-impl Bounce {
-    /// No interreflection (`skin.interreflection = false`, `--occlusion off`).
-    pub fn none(vertices: usize) -> Bounce {
-        Bounce {
-            coeffs: vec![[[0.0; 9]; 3]; vertices],
-        }
-    }
-}
 
 /// One row of the bounce operator: (vertex, RGB weight) pairs.
 type Row = Vec<(u32, [f32; 3])>;
@@ -110,13 +95,13 @@ fn row(
 
 /// `B ← K·(T + B)` until converged (module doc, [`TOLERANCE`]); also the
 /// number of bounces summed.
-fn iterate(rows: &[Row], direct: &Transfer) -> (Bounce, u32) {
+fn iterate(rows: &[Row], direct: &Transfer) -> (RgbTransfer, u32) {
     let scale = direct
         .coeffs
         .iter()
         .flatten()
         .fold(0.0f32, |a, t| a.max(t.abs()));
-    let mut b = Bounce::none(rows.len());
+    let mut b = RgbTransfer::none(rows.len());
     for bounce in 1..=MAX_BOUNCES {
         let next: Vec<[[f32; 9]; 3]> = rows
             .par_iter()
@@ -149,7 +134,12 @@ fn iterate(rows: &[Row], direct: &Transfer) -> (Bounce, u32) {
 
 /// The interreflected transfer of `mesh` under `direct` (its direct transfer)
 /// with the albedo map `albedo`, by rays cast as `opts` says (module doc).
-pub fn interreflect(mesh: &Mesh, albedo: &Texture, direct: &Transfer, opts: &RayOptions) -> Bounce {
+pub fn interreflect(
+    mesh: &Mesh,
+    albedo: &Texture,
+    direct: &Transfer,
+    opts: &RayOptions,
+) -> RgbTransfer {
     let start = Instant::now();
     let bvh = Bvh::from_mesh(mesh);
     let invalid = AtomicUsize::new(0);
@@ -196,9 +186,14 @@ fn albedo_hash(albedo: &Texture) -> u64 {
 /// occlusion `mode` (none for `Off`), from the disk cache when it holds it
 /// (keyed by the mesh, the direct transfer's key, the albedo map and the
 /// settings).
-pub fn bounce_for(mesh: &Mesh, albedo: &Texture, direct: &Transfer, mode: Occlusion) -> Bounce {
+pub fn bounce_for(
+    mesh: &Mesh,
+    albedo: &Texture,
+    direct: &Transfer,
+    mode: Occlusion,
+) -> RgbTransfer {
     let Some(direct_key) = transfer_key(mesh, mode) else {
-        return Bounce::none(mesh.vertex_count());
+        return RgbTransfer::none(mesh.vertex_count());
     };
     let opts = RayOptions {
         // Other directions than the direct transfer's: independent noise.
@@ -211,69 +206,27 @@ pub fn bounce_for(mesh: &Mesh, albedo: &Texture, direct: &Transfer, mode: Occlus
         albedo_hash(albedo)
     );
     let key = cache_key(mesh, "interreflection", &settings);
-    let dir = default_cache_dir();
-    let count = mesh.vertex_count();
-    // Cached as a transfer of three rows per vertex (R, G, B).
-    if let Some(t) = load_cached(&dir, &key).filter(|t| t.coeffs.len() == 3 * count) {
-        log::info!("interreflection: cached {key} from {}", dir.display());
-        let coeffs = t
-            .coeffs
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        return Bounce { coeffs };
-    }
-    let b = interreflect(mesh, albedo, direct, &opts);
-    let flat = Transfer {
-        coeffs: b.coeffs.iter().flatten().copied().collect(),
-    };
-    if let Err(e) = store_cached(&dir, &key, &flat) {
-        log::warn!("interreflection: cannot cache in {}: {e}", dir.display());
-    }
-    b
+    rgb_cached("interreflection", &key, mesh.vertex_count(), || {
+        interreflect(mesh, albedo, direct, &opts)
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::occlusion::testutil::mesh;
+    use crate::light::occlusion::testutil::open_sphere;
     use crate::light::occlusion::{raytrace, unoccluded};
     use crate::scene::texture::Encoding;
     use std::f32::consts::PI;
 
-    /// A sphere of radius `r` seen from inside (normals inward) with the cap
-    /// within `alpha` of +Y removed: rings of vertices from polar angle
-    /// `alpha` to π, the last a single pole.
+    /// A sphere of radius `r` without the cap within `alpha` of +Y, seen
+    /// from inside (normals inward).
     fn cavity(r: f32, alpha: f32, rings: u32, segments: u32) -> Mesh {
-        let (mut p, mut n, mut idx) = (Vec::new(), Vec::new(), Vec::new());
-        for i in 0..rings {
-            let theta = alpha + (PI - alpha) * i as f32 / rings as f32;
-            for j in 0..segments {
-                let phi = 2.0 * PI * j as f32 / segments as f32;
-                let d = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    theta.sin() * phi.sin(),
-                );
-                p.push(r * d);
-                n.push(-d);
-            }
+        let mut m = open_sphere(r, alpha, rings, segments);
+        for n in &mut m.normals {
+            *n = -*n;
         }
-        let pole = p.len() as u32;
-        p.push(Vec3::new(0.0, -r, 0.0));
-        n.push(Vec3::Y);
-        for i in 0..rings {
-            for j in 0..segments {
-                let at = |i: u32, j: u32| i * segments + j % segments;
-                if i + 1 < rings {
-                    let (a, b, c, d) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
-                    idx.extend([a, b, c, a, c, d]);
-                } else {
-                    idx.extend([at(i, j), at(i, j + 1), pole]);
-                }
-            }
-        }
-        mesh(p, n, idx)
+        m
     }
 
     /// Inside a sphere every point sees every area element dA of it with the
@@ -328,10 +281,7 @@ mod tests {
     /// A convex mesh sees none of itself: no interreflection.
     #[test]
     fn a_convex_mesh_reflects_nothing_onto_itself() {
-        let mut m = cavity(100.0, 0.3, 16, 32);
-        for n in &mut m.normals {
-            *n = -*n;
-        }
+        let m = open_sphere(100.0, 0.3, 16, 32);
         let albedo = Texture::solid([255; 4], Encoding::Linear);
         let b = interreflect(&m, &albedo, &unoccluded(&m), &RayOptions::default());
         // The open cap's rim is the only place a ray can meet the mesh again.

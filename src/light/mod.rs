@@ -13,6 +13,7 @@ pub mod sh;
 pub mod sh_pass;
 pub mod shadow;
 pub mod skybox;
+pub mod transmission;
 pub mod visibility;
 
 /// The tag of the lighting passes (SH, prefilter, shadows, direct lighting).

@@ -18,10 +18,12 @@ use crate::light::direct::DirectPass;
 use crate::light::extract::extract;
 use crate::light::interreflection;
 use crate::light::lighting::Lighting;
+use crate::light::occlusion::RgbTransfer;
 use crate::light::prefilter::PrefilterPass;
 use crate::light::sh_pass::{ShBuffers, ShPasses};
 use crate::light::shadow::{atlas_grid, lobe_widening, ShadowPass, ShadowView};
 use crate::light::skybox;
+use crate::light::transmission;
 use crate::light::visibility::{VisibilityPass, TEXTURES};
 use crate::post::debug::{DebugPass, DepthRange};
 use crate::post::glow::Glow;
@@ -147,6 +149,7 @@ fn frame_inputs(
     lighting: &Lighting,
     residual: Option<&crate::scene::env::EnvMap>,
     uniforms: &FrameUniforms,
+    skin: &SkinSettings,
 ) -> Result<FrameInputs> {
     let samplers = Arc::new(Samplers::new(ctx)?);
     let env = upload_env(ctx, &scene.env)?;
@@ -159,11 +162,26 @@ fn frame_inputs(
     };
     let occlusion = scene.file.skin.occlusion;
     let transfer = crate::light::occlusion::transfer_for(ctx, &scene.mesh, occlusion)?;
+    let n = scene.mesh.vertex_count();
     let bounce = if scene.file.skin.interreflection {
         interreflection::bounce_for(&scene.mesh, albedo, &transfer, occlusion)
     } else {
-        interreflection::Bounce::none(scene.mesh.vertex_count())
+        RgbTransfer::none(n)
     };
+    let through = transmission::transmitted_for(
+        &scene.mesh,
+        &transfer,
+        occlusion,
+        &skin.profile,
+        skin.transmission,
+    );
+    // Per vertex: the interreflected transfer, then the transmitted one.
+    let rgb: Vec<[[[f32; 9]; 3]; 2]> = bounce
+        .coeffs
+        .iter()
+        .zip(&through.coeffs)
+        .map(|(b, t)| [*b, *t])
+        .collect();
     Ok(FrameInputs {
         uniforms: upload_buffer(
             ctx,
@@ -180,10 +198,10 @@ fn frame_inputs(
             bytemuck::cast_slice(&transfer.coeffs),
             Access::ShaderBufferRead,
         )?,
-        bounce: upload_buffer(
+        rgb_transfer: upload_buffer(
             ctx,
-            "interreflected transfer",
-            bytemuck::cast_slice(&bounce.coeffs),
+            "interreflected and transmitted transfer",
+            bytemuck::cast_slice(&rgb),
             Access::ShaderBufferRead,
         )?,
         specular: upload_rgba8(ctx, "specular map", &scene.specular)?,
@@ -349,7 +367,7 @@ impl Frame {
                 (specular_map.0, specular_map.1, &scene.specular.rgba8),
             );
         let uniforms = frame_uniforms(scene, &lighting, w as f32 / h as f32, specular_scale);
-        let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms)?;
+        let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms, &skin)?;
         let s = &inputs.samplers;
         let tables = SpecularTables::new(
             ctx,

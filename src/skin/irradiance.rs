@@ -57,7 +57,7 @@ impl IrradiancePass {
             pass = pass.sample(v, &s.linear);
         }
         let pass = pass
-            .buffer(&inputs.bounce)
+            .buffer(&inputs.rgb_transfer)
             .color(&mut out, LoadOp::Clear([0.0; 4]))
             .constants(&mix);
         inputs.mesh.draw(pass);

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::transfer::Transfer;
+use super::transfer::{RgbTransfer, Transfer};
 use crate::scene::mesh::Mesh;
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -192,6 +192,35 @@ pub fn store_cached(dir: &Path, key: &str, t: &Transfer) -> crate::Result<()> {
         source,
     })?;
     crate::atomic::write_atomic(&path, encode(key, t))
+}
+
+/// `compute()`'s RGB transfer of `vertices` vertices, or the copy cached under
+/// `key` (stored as a transfer of three rows per vertex, R, G, B); `what`
+/// names it in the log.
+pub fn rgb_cached(
+    what: &str,
+    key: &str,
+    vertices: usize,
+    compute: impl FnOnce() -> RgbTransfer,
+) -> RgbTransfer {
+    let dir = default_cache_dir();
+    if let Some(t) = load_cached(&dir, key).filter(|t| t.coeffs.len() == 3 * vertices) {
+        log::info!("{what}: cached {key} from {}", dir.display());
+        let coeffs = t
+            .coeffs
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        return RgbTransfer { coeffs };
+    }
+    let t = compute();
+    let flat = Transfer {
+        coeffs: t.coeffs.iter().flatten().copied().collect(),
+    };
+    if let Err(e) = store_cached(&dir, key, &flat) {
+        log::warn!("{what}: cannot cache in {}: {e}", dir.display());
+    }
+    t
 }
 
 #[cfg(test)]

@@ -27,10 +27,10 @@ pub(crate) mod testutil;
 mod transfer;
 
 pub use bvh::{Bvh, Hit};
-pub use cache::{cache_key, default_cache_dir, load_cached, store_cached};
+pub use cache::{cache_key, default_cache_dir, load_cached, rgb_cached, store_cached};
 pub(crate) use raytrace::directions;
 pub use raytrace::{raytrace, RayOptions};
-pub use transfer::{unoccluded, Transfer};
+pub use transfer::{unoccluded, RgbTransfer, Transfer};
 
 use std::sync::Arc;
 

@@ -77,3 +77,38 @@ pub(super) fn cylinder(r: f32, d: f32, seg: u32) -> Mesh {
     }
     mesh(p, n, idx)
 }
+
+/// A sphere of radius `r` about the origin without the cap within polar angle
+/// `alpha` of +Y (0: whole), normals outward: `rings` rings of `segments`
+/// vertices from `alpha` towards −Y, closed by a vertex at the pole.
+pub(crate) fn open_sphere(r: f32, alpha: f32, rings: u32, segments: u32) -> Mesh {
+    let (mut p, mut n, mut idx) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..rings {
+        let theta = alpha.max(1e-3) + (PI - alpha.max(1e-3)) * i as f32 / rings as f32;
+        for j in 0..segments {
+            let phi = 2.0 * PI * j as f32 / segments as f32;
+            let d = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            p.push(r * d);
+            n.push(d);
+        }
+    }
+    let pole = p.len() as u32;
+    p.push(Vec3::new(0.0, -r, 0.0));
+    n.push(Vec3::NEG_Y);
+    let at = |i: u32, j: u32| i * segments + j % segments;
+    for i in 0..rings {
+        for j in 0..segments {
+            if i + 1 < rings {
+                let (a, b, c, d) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
+                idx.extend([a, b, c, a, c, d]);
+            } else {
+                idx.extend([at(i, j), at(i, j + 1), pole]);
+            }
+        }
+    }
+    mesh(p, n, idx)
+}

@@ -11,6 +11,23 @@ pub struct Transfer {
     pub coeffs: Vec<[f32; 9]>,
 }
 
+/// Nine coefficients per colour channel (R, G, B) per vertex: a transfer
+/// that depends on the skin's colour (light::interreflection,
+/// light::transmission).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbTransfer {
+    pub coeffs: Vec<[[f32; 9]; 3]>,
+}
+
+impl RgbTransfer {
+    /// All zero: no light of this kind.
+    pub fn none(vertices: usize) -> RgbTransfer {
+        RgbTransfer {
+            coeffs: vec![[[0.0; 9]; 3]; vertices],
+        }
+    }
+}
+
 /// `T = sh::cosine_transfer(N)` per vertex (no occlusion). Vertices whose
 /// normal is missing, zero or non-finite get zeros.
 pub fn unoccluded(mesh: &Mesh) -> Transfer {
