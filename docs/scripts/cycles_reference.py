@@ -64,6 +64,25 @@ def parse_args(argv):
         default="uniform",
         help="'uniform' (radiance 1, dermis: uniform:1,1,1) or a lat-long .hdr/.exr",
     )
+    p.add_argument(
+        "--camera",
+        metavar="X,Y,Z:TX,TY,TZ:FOV",
+        help="eye and target (dermis world, mm, +Y up) and vertical field of view "
+        "(degrees), as a scene's [camera]; default: assets/default.toml's",
+    )
+    p.add_argument(
+        "--sun",
+        metavar="DX,DY,DZ:E",
+        help="a directional light, as a scene's [[lights]]: the direction it travels "
+        "(dermis world) and its irradiance facing it (the sky's radiance units), "
+        "point-like",
+    )
+    p.add_argument(
+        "--sky",
+        type=float,
+        default=1.0,
+        help="the uniform sky's radiance (dermis: uniform:L)",
+    )
     p.add_argument("--width", type=int, default=192)
     p.add_argument("--height", type=int, default=240)
     p.add_argument("--samples", type=int, default=1024)
@@ -123,6 +142,29 @@ def parse_args(argv):
     out_dir = os.path.dirname(os.path.abspath(args.out))
     if not os.path.isdir(out_dir):
         p.error(f"--out: no folder {out_dir}")
+    def floats(text, n, what):
+        try:
+            v = tuple(float(c) for c in text.split(","))
+        except ValueError:
+            v = ()
+        if len(v) != n:
+            p.error(f"{what}: {n} comma-separated numbers, not {text!r}")
+        return v
+
+    if args.camera:
+        parts = args.camera.split(":")
+        if len(parts) != 3:
+            p.error("--camera: X,Y,Z:TX,TY,TZ:FOV")
+        args.camera = (
+            floats(parts[0], 3, "--camera eye"),
+            floats(parts[1], 3, "--camera target"),
+            floats(parts[2], 1, "--camera fov")[0],
+        )
+    if args.sun:
+        parts = args.sun.split(":")
+        if len(parts) != 2:
+            p.error("--sun: DX,DY,DZ:E")
+        args.sun = (floats(parts[0], 3, "--sun direction"), floats(parts[1], 1, "--sun E")[0])
     if args.env != "uniform" and not os.path.isfile(args.env):
         p.error(f"--env: no file {args.env}")
     if args.slab is not None:
@@ -257,7 +299,7 @@ def world(args):
     if args.view == "albedo":
         bg.inputs["Color"].default_value = (0, 0, 0, 1)
     elif args.env == "uniform":
-        bg.inputs["Color"].default_value = (1, 1, 1, 1)
+        bg.inputs["Color"].default_value = (args.sky, args.sky, args.sky, 1)
     else:
         tex = nodes.new("ShaderNodeTexEnvironment")
         tex.image = bpy.data.images.load(os.path.abspath(args.env))
@@ -307,12 +349,15 @@ def tilt_slab_camera(cam, mu):
 def camera(args):
     data = bpy.data.cameras.new("camera")
     data.sensor_fit = "VERTICAL"
-    data.angle_y = math.radians(CAMERA_FOV_Y_DEG)
+    eye_mm, target_mm, fov = CAMERA_POSITION_MM, CAMERA_TARGET_MM, CAMERA_FOV_Y_DEG
+    if args.camera:
+        eye_mm, target_mm, fov = args.camera
+    data.angle_y = math.radians(fov)
     data.clip_start = 0.01
     data.clip_end = 1000.0
     cam = bpy.data.objects.new("camera", data)
-    eye = to_blender(CAMERA_POSITION_MM)
-    target = to_blender(CAMERA_TARGET_MM)
+    eye = to_blender(eye_mm)
+    target = to_blender(target_mm)
     # Look along -Z with +Y up, dermis's look_at with world up (+Y, Blender's +Z).
     rot = (target - eye).to_track_quat("-Z", "Y").to_matrix().to_4x4()
     cam.matrix_world = Matrix.Translation(eye) @ rot
@@ -332,6 +377,15 @@ def main():
     head.data.materials.append(skin_material(args))
     scene.world = world(args)
     scene.camera = slab_camera() if args.slab else camera(args)
+    if args.sun:
+        direction, irradiance = args.sun
+        sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
+        sun.data.energy, sun.data.angle = irradiance, 0.0
+        # A sun shines along its local -Z; dermis's direction is unitless, so
+        # only its turn (to_blender's axes) matters.
+        travel = to_blender(direction).normalized()
+        sun.rotation_euler = travel.to_track_quat("-Z", "Y").to_euler()
+        scene.collection.objects.link(sun)
 
     scene.render.engine = "CYCLES"
     cy = scene.cycles
