@@ -8,7 +8,7 @@
 // (light/transmission.rs; the lights' is the final pass's), zero without them.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
-#include "sh.glsl"
+#include "sh_basis.glsl"
 #define RGB_TRANSFER 14
 #include "transfer.glsl"
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;

@@ -305,24 +305,31 @@ fn region_irradiance(
     std::array::from_fn(|i| (sum[i] / count[i].max(1) as f64) as f32)
 }
 
-#[test]
-fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
-    use dermis::scene::file::Occlusion;
-    use dermis::scene::head::{
-        REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES, REGION_NOSE,
-    };
-    let on = region_irradiance(Occlusion::Raytrace, false, 0.0);
-    let off = region_irradiance(Occlusion::Off, false, 0.0);
+/// Per region, `on / off`, printed with both under `what`.
+fn region_gains(what: &str, on: [f32; 10], off: [f32; 10]) -> [f32; 10] {
+    use dermis::scene::head::REGION_NAMES;
     for i in 0..10 {
         println!(
-            "{:<14} on {:.3} off {:.3} ratio {:.3}",
+            "{:<14} {what} on {:.3} off {:.3} ratio {:.4}",
             REGION_NAMES[i],
             on[i],
             off[i],
             on[i] / off[i]
         );
     }
-    let ratio = |r: u8| on[r as usize] / off[r as usize];
+    std::array::from_fn(|i| on[i] / off[i])
+}
+
+#[test]
+fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
+    use dermis::scene::file::Occlusion;
+    use dermis::scene::head::{REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NOSE};
+    let gains = region_gains(
+        "occlusion",
+        region_irradiance(Occlusion::Raytrace, false, 0.0),
+        region_irradiance(Occlusion::Off, false, 0.0),
+    );
+    let ratio = |r: u8| gains[r as usize];
     // Without occlusion a uniform sky gives E = π·L everywhere (the albedo^mix aside).
     assert!(
         ratio(REGION_EYES) < 0.8,
@@ -350,18 +357,12 @@ fn occlusion_darkens_the_concavities_under_a_uniform_red_sky() {
 fn interreflection_brightens_the_concavities_most() {
     use dermis::scene::file::Occlusion;
     use dermis::scene::head::{REGION_EARS, REGION_EYES, REGION_FOREHEAD, REGION_NAMES};
-    let on = region_irradiance(Occlusion::Raytrace, true, 0.0);
-    let off = region_irradiance(Occlusion::Raytrace, false, 0.0);
-    for i in 0..10 {
-        println!(
-            "{:<14} bounce on {:.3} off {:.3} ratio {:.3}",
-            REGION_NAMES[i],
-            on[i],
-            off[i],
-            on[i] / off[i]
-        );
-    }
-    let gain = |r: u8| on[r as usize] / off[r as usize];
+    let gains = region_gains(
+        "interreflection",
+        region_irradiance(Occlusion::Raytrace, true, 0.0),
+        region_irradiance(Occlusion::Raytrace, false, 0.0),
+    );
+    let gain = |r: u8| gains[r as usize];
     for i in 0..10u8 {
         assert!(gain(i) >= 1.0, "{}: {}", REGION_NAMES[i as usize], gain(i));
     }
@@ -387,19 +388,13 @@ fn the_sky_shines_through_the_ears_only() {
     use dermis::scene::head::{
         REGION_EARS, REGION_FOREHEAD, REGION_LEFT_CHEEK, REGION_NAMES, REGION_RIGHT_CHEEK,
     };
-    let on = region_irradiance(Occlusion::Raytrace, false, 1.0);
-    let off = region_irradiance(Occlusion::Raytrace, false, 0.0);
-    for i in 0..10 {
-        println!(
-            "{:<14} transmitted on {:.3} off {:.3} ratio {:.4}",
-            REGION_NAMES[i],
-            on[i],
-            off[i],
-            on[i] / off[i]
-        );
-    }
+    let gains = region_gains(
+        "transmission",
+        region_irradiance(Occlusion::Raytrace, false, 1.0),
+        region_irradiance(Occlusion::Raytrace, false, 0.0),
+    );
     // Measured: ears +0.4 %, nose (nostrils) +0.4 %, forehead and cheeks 0.
-    let gain = |r: u8| on[r as usize] / off[r as usize];
+    let gain = |r: u8| gains[r as usize];
     assert!(gain(REGION_EARS) > 1.002, "ears: {}", gain(REGION_EARS));
     for r in [REGION_FOREHEAD, REGION_LEFT_CHEEK, REGION_RIGHT_CHEEK] {
         assert!(

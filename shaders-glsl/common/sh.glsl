@@ -12,17 +12,3 @@ vec3 sh_irradiance(vec4 L[9], vec3 n) {
          + 2.0 * C1 * (L[4].rgb * x * y + L[7].rgb * x * z + L[5].rgb * y * z)
          + 2.0 * C2 * (L[3].rgb * x + L[1].rgb * y + L[2].rgb * z);
 }
-
-// The nine real SH basis functions at unit direction d (R&H 2001 eq. 3; the
-// order and constants of light/sh.rs basis).
-void sh_basis(vec3 d, out float y[9]) {
-    y[0] = 0.282095;
-    y[1] = 0.488603 * d.y;
-    y[2] = 0.488603 * d.z;
-    y[3] = 0.488603 * d.x;
-    y[4] = 1.092548 * d.x * d.y;
-    y[5] = 1.092548 * d.y * d.z;
-    y[6] = 0.315392 * (3.0 * d.z * d.z - 1.0);
-    y[7] = 1.092548 * d.x * d.z;
-    y[8] = 0.546274 * (d.x * d.x - d.y * d.y);
-}
