@@ -19,7 +19,7 @@
 //!
 //! # What is left out
 //! Back faces (the inside of the head) reflect nothing. The oil layer's share
-//! at the hit (ρs·Ā ≈ 1–3 % of the light entering, skin::specular) is kept in
+//! at the hit (ρs·Ā ≈ 4 % of the light entering, docs/skin.md) is kept in
 //! the skin: `ρ` is the albedo map alone. The GPU applies `B` to the
 //! environment's SH and to the explicit lights projected into SH at the
 //! receiving vertex (`uv_lit.vert`), so a lamp's light bounces as if the
