@@ -18,9 +18,10 @@
 //! barycentrics × ρ / n) is built once from one ray cast per direction.
 //!
 //! # What is left out
-//! Back faces (the inside of the head) reflect nothing. The oil layer's share
-//! at the hit (ρs·Ā ≈ 4 % of the light entering, docs/skin.md) is kept in
-//! the skin: `ρ` is the albedo map alone. The GPU applies `B` to the
+//! Back faces (the inside of the head) reflect nothing. The hit reflects
+//! `ρ·E`: its oil layer takes ρs·Ā ≈ 4 % of the light from the diffuse
+//! (docs/skin.md) and reflects it itself, so `ρ`, the albedo map, stands for
+//! both within ρs·Ā·(1 − ρ) ≈ 2 % of the hit's light. The GPU applies `B` to the
 //! environment's SH and to the explicit lights projected into SH at the
 //! receiving vertex (`uv_lit.vert`), so a lamp's light bounces as if the
 //! hit's own occlusion shadowed it: second-order light, low in frequency.
