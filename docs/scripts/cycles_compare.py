@@ -184,8 +184,14 @@ def main():
     p.add_argument("--png", help="write dermis | reference | difference")
     p.add_argument("--diff-scale", type=float, default=0.2, help="difference at full colour")
     p.add_argument("--regions-png", help="write the region masks over the reference")
+    p.add_argument(
+        "--unlit",
+        help="a dermis render (.exr) of the lights alone (e.g. --view direct under "
+        "--env uniform:0,0,0): its black pixels, where no light reaches directly, "
+        "form the groups 'unlit' and 'REGION unlit'",
+    )
     args = p.parse_args()
-    for f in [args.dermis] + args.cycles:
+    for f in [args.dermis] + args.cycles + ([args.unlit] if args.unlit else []):
         if not os.path.isfile(f):
             p.error(f"no file {f}")
     for out in (args.json, args.png, args.regions_png):
@@ -212,6 +218,13 @@ def main():
     for i, name in enumerate(LANDMARK_NAMES):
         groups[name] = region == i
     groups.update(extra_groups(offset))
+    if args.unlit:
+        unlit_image = read_dermis(args.unlit)
+        if unlit_image.shape != dermis.shape:
+            p.error(f"sizes differ: dermis {dermis.shape[:2]}, --unlit {unlit_image.shape[:2]}")
+        unlit = luminance(unlit_image[mask][:, :3]) <= 0.0
+        for name in list(groups):
+            groups[f"{name} unlit" if name != "mesh" else "unlit"] = groups[name] & unlit
 
     result = {"coverage_iou": coverage_iou, "floor": floor, "groups": {}}
     if len(refs) >= 2:
