@@ -90,10 +90,13 @@ pub struct ShadePass {
     /// wound, so back faces are not culled; without it their fragments are shaded
     /// wherever they are drawn before the faces in front: ~25 % of the pass).
     depth: Arc<Pipeline>,
-    pipeline: Arc<Pipeline>,
+    /// Indexed by whether the unblurred irradiance is mixed in (blur_amount
+    /// < 1: skin.frag's UNBLURRED); at 1 its lookup would be multiplied by 0.
+    pipelines: [Arc<Pipeline>; 2],
 }
 
-/// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's.
+/// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
+/// `UNBLURRED`.
 const TRANSMISSION_CONSTANT: usize = 5;
 
 impl ShadePass {
@@ -104,9 +107,11 @@ impl ShadePass {
         let mut specialization = variant.specialization().to_vec();
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
-        // The same vertex shader for both, so the shading pass's depth equals the
+        // The same vertex shader for all, so the shading pass's depth equals the
         // pre-pass's exactly.
-        let mesh = |fragment, color_formats, depth_write| {
+        let mesh = |fragment, color_formats, depth_write, unblurred: bool| {
+            let mut specialization = specialization.clone();
+            specialization.push(u32::from(unblurred));
             pipelines.graphics(&GraphicsDesc {
                 vertex: "mesh_lit.vert",
                 fragment,
@@ -120,8 +125,11 @@ impl ShadePass {
             })
         };
         Ok(Self {
-            depth: mesh("depth_only.frag", &[], true)?,
-            pipeline: mesh("skin.frag", &[HDR_FORMAT], false)?,
+            depth: mesh("depth_only.frag", &[], true, false)?,
+            pipelines: [
+                mesh("skin.frag", &[HDR_FORMAT], false, false)?,
+                mesh("skin.frag", &[HDR_FORMAT], false, true)?,
+            ],
         })
     }
 
@@ -152,7 +160,10 @@ impl ShadePass {
         // specular environment, irradiance, six blur levels, the specular
         // bindings, the soft lights' visibility, the atlas's depths.
         let mut pass = g
-            .simple_pass("skin", &self.pipeline)
+            .simple_pass(
+                "skin",
+                &self.pipelines[usize::from(settings.blur_amount < 1.0)],
+            )
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
