@@ -53,7 +53,8 @@ float tap_moment(float o) {
     return n * n + (o - n) * (2.0 * n + 1.0);
 }
 
-// The box of a HALF pass's centre tap, destination texels² per axis.
+// The box of a HALF pass's centre tap, destination texels² per axis
+// (skin::chain::HALF_BOX_TEXELS2).
 const float BOX = HALF ? 1.0 / 16.0 : 0.0;
 
 // The offset o (destination texels) of a HALF pass's tap whose second moment

@@ -420,7 +420,7 @@ fn a_narrow_gaussian_in_one_pass_has_its_covariance() {
 #[test]
 fn a_narrow_gaussian_that_halves_the_resolution_in_one_pass_has_its_covariance() {
     // The 5×5 stencil from a source of twice the side (N to N/2), σ of 0.5,
-    // 0.97 (the scan's levels 5 and 6 at 1024²) and 1.2 texels of the
+    // 0.97 (the scan's levels 5 and 6 at 1024²) and 1.22 texels of the
     // destination along u, on a plain and a sheared plane (cos 0.6). An
     // impulse's response depends on where it falls in the 2×2 texels of N a
     // destination texel covers, so the four placements are summed (each
@@ -432,7 +432,7 @@ fn a_narrow_gaussian_that_halves_the_resolution_in_one_pass_has_its_covariance()
     let variance = (sigma * sigma) as f64;
     let side = N / 2;
     for cos in [0.0, 0.6] {
-        for texels in [0.5, 0.97, 1.2] {
+        for texels in [0.5, 0.97, 1.22] {
             let (mesh, jacobian) = sheared_plane(side as f32 * sigma / texels, cos);
             let moments = |one_pass| {
                 let mut sum = vec![0.0f32; (N * N) as usize];

@@ -8,7 +8,8 @@
 //! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
 //! of its source's resolution is blurred in one pass instead of two (issue 24);
 //! so is a level that halves its source's side, with the 5×5 stencil, where
-//! its σ spans at most that in texels of its own resolution.
+//! its σ spans at most that in texels of its own resolution beyond the 2×2 box
+//! its centre tap reads.
 
 use super::profile::Profile;
 use crate::scene::file::Chain;
@@ -23,6 +24,10 @@ pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
 /// The coarsest level the adaptive chain goes down to.
 pub const MIN_RESOLUTION: u32 = 64;
+/// Variance per axis, in texels² of a level that halves its source's side,
+/// of a bilinear tap at a texel centre of the level: the 2×2 box of the source
+/// texels it covers (blur_narrow.comp's BOX).
+pub const HALF_BOX_TEXELS2: f32 = 1.0 / 16.0;
 /// The texel neighbourhood of a level blurred in one pass (blur_narrow.comp),
 /// both directions at once, from a source of its own resolution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,17 +53,18 @@ impl Stencil {
 
     /// The smallest stencil for a blur of `sigma_texels` (at the level's
     /// resolution) from a source of the same side, or only the 5×5 from one
-    /// of twice the side (`halves`: blur_narrow.comp's HALF); `None`: two
-    /// passes.
+    /// of twice the side (`halves`: blur_narrow.comp's HALF, whose centre tap,
+    /// a 2×2 box of the source, holds [`HALF_BOX_TEXELS2`] of the variance
+    /// and the stencil the rest); `None`: two passes.
     fn for_sigma(sigma_texels: f32, halves: bool) -> Option<Self> {
-        let stencils: &[Self] = if halves {
-            &[Stencil::Five]
-        } else {
-            &[Stencil::Three, Stencil::Five]
-        };
-        stencils
-            .iter()
-            .copied()
+        if halves {
+            let stencil = (sigma_texels * sigma_texels - HALF_BOX_TEXELS2)
+                .max(0.0)
+                .sqrt();
+            return (stencil <= Stencil::Five.max_sigma_texels()).then_some(Stencil::Five);
+        }
+        [Stencil::Three, Stencil::Five]
+            .into_iter()
             .find(|s| sigma_texels <= s.max_sigma_texels())
     }
 }
@@ -224,15 +230,16 @@ mod tests {
                 Some(Five)
             ]
         );
-        // At 4096² (6.46 texels/mm) level 2 is 1.42 texels and level 3, at
-        // 2048², 1.202: two passes each; levels 4-6 halve with under a texel.
+        // At 4096² (6.46 texels/mm) level 2 is 1.42 texels: two passes.
+        // Level 3 halves to 2048² with 1.202 texels, 1.176 beyond the box of
+        // its centre tap; levels 4-6 halve with under a texel.
         let stencils: Vec<Option<Stencil>> = plan(&Profile::skin(), Chain::Adaptive, 4096, 6.46)
             .iter()
             .map(|l| l.one_pass)
             .collect();
         assert_eq!(
             stencils,
-            [None, None, None, Some(Five), Some(Five), Some(Five)]
+            [None, None, Some(Five), Some(Five), Some(Five), Some(Five)]
         );
     }
 
