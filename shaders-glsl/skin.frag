@@ -50,7 +50,7 @@ layout(push_constant) uniform Push {
 // without it the shader is the one without the term.
 layout(constant_id = 5) const bool TRANSMISSION = false;
 // With blur_amount < 1 the unblurred irradiance is mixed in; at 1 (the
-// default) the pass is built without its lookup.
+// default) the pass is built without its lookup (skin::shade::ShadePass::new).
 layout(constant_id = 6) const bool UNBLURRED = true;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;

@@ -90,9 +90,7 @@ pub struct ShadePass {
     /// wound, so back faces are not culled; without it their fragments are shaded
     /// wherever they are drawn before the faces in front: ~25 % of the pass).
     depth: Arc<Pipeline>,
-    /// Indexed by whether the unblurred irradiance is mixed in (blur_amount
-    /// < 1: skin.frag's UNBLURRED); at 1 its lookup would be multiplied by 0.
-    pipelines: [Arc<Pipeline>; 2],
+    pipeline: Arc<Pipeline>,
 }
 
 /// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
@@ -103,15 +101,21 @@ impl ShadePass {
     /// `transmission`: build the final pass with the transmitted term (a
     /// specialization constant: without it the shader is the one without the
     /// term, so `skin.transmission = 0` costs nothing and changes no bit).
-    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, transmission: bool) -> Result<Self> {
+    /// `unblurred`: with the unblurred irradiance mixed in (`skin.blur_amount`
+    /// < 1; at 1 its lookup would be multiplied by 0).
+    pub fn new(
+        pipelines: &Pipelines,
+        variant: &ShaderVariant,
+        transmission: bool,
+        unblurred: bool,
+    ) -> Result<Self> {
         let mut specialization = variant.specialization().to_vec();
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
-        // The same vertex shader for all, so the shading pass's depth equals the
+        specialization.push(u32::from(unblurred));
+        // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
-        let mesh = |fragment, color_formats, depth_write, unblurred: bool| {
-            let mut specialization = specialization.clone();
-            specialization.push(u32::from(unblurred));
+        let mesh = |fragment, color_formats, depth_write| {
             pipelines.graphics(&GraphicsDesc {
                 vertex: "mesh_lit.vert",
                 fragment,
@@ -125,11 +129,8 @@ impl ShadePass {
             })
         };
         Ok(Self {
-            depth: mesh("depth_only.frag", &[], true, false)?,
-            pipelines: [
-                mesh("skin.frag", &[HDR_FORMAT], false, false)?,
-                mesh("skin.frag", &[HDR_FORMAT], false, true)?,
-            ],
+            depth: mesh("depth_only.frag", &[], true)?,
+            pipeline: mesh("skin.frag", &[HDR_FORMAT], false)?,
         })
     }
 
@@ -160,10 +161,7 @@ impl ShadePass {
         // specular environment, irradiance, six blur levels, the specular
         // bindings, the soft lights' visibility, the atlas's depths.
         let mut pass = g
-            .simple_pass(
-                "skin",
-                &self.pipelines[usize::from(settings.blur_amount < 1.0)],
-            )
+            .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
