@@ -467,8 +467,12 @@ fn shear_correction_holds_down_the_adaptive_chain() {
     // (512² to 128² at level 2 here) as the V passes step along the sheared
     // direction: each level's surface covariance is its total variance v_k,
     // isotropic, once the bilinear upsampling to N² (a tent of (N/side)²/6
-    // texels² along u and v) is taken off — as close as on an unsheared plane
-    // (cos 0), where the adaptive chain's own coarseness is all there is.
+    // texels² along u and v) is taken off. Unsheared (cos 0), the adaptive
+    // chain's own coarseness is all there is: 1.4 % with the levels that halve
+    // in one pass (4.4 % when they were two passes). Sheared, the worst is
+    // level 4, two passes at 64² whose V pass interpolates across columns:
+    // 5.2 % (6.7 % before). Without the shear correction the eigen-variances
+    // would be σ²(1 ± cos), 60 % off.
     let profile = Profile::skin();
     let mut worst = [0.0f64; 2];
     for (i, cos) in [0.0, 0.6].into_iter().enumerate() {
@@ -502,8 +506,8 @@ fn shear_correction_holds_down_the_adaptive_chain() {
         "worst relative error: unsheared {:.4}, sheared {:.4}",
         worst[0], worst[1]
     );
-    assert!(worst[1] < worst[0] + 0.03, "{worst:?}");
-    assert!(worst[1] < 0.08, "{worst:?}");
+    assert!(worst[0] < 0.03, "{worst:?}");
+    assert!(worst[1] < 0.06, "{worst:?}");
 }
 
 /// A chart covering the UV square [0.25, 0.75]², gutter around it; `f(x, y)`
