@@ -29,7 +29,8 @@ pub const MIN_RESOLUTION: u32 = 64;
 /// texels it covers (blur_narrow.comp's BOX).
 pub const HALF_BOX_TEXELS2: f32 = 1.0 / 16.0;
 /// The texel neighbourhood of a level blurred in one pass (blur_narrow.comp),
-/// both directions at once, from a source of its own resolution.
+/// both directions at once, from a source of its own resolution (or, the 5×5
+/// only, of twice it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stencil {
     /// 3×3, four bilinear taps: per axis the tent m/2, 1 − m, m/2 of variance
