@@ -22,8 +22,17 @@
 // centre and a pair at ±(1 + a2/(a1 + a2)); in 2-D the tensor product of the two
 // axes, with weight moved from the axes' taps to the corners where the cross
 // moment needs more than the product holds.
+//
+// HALF (with FIVE only): the source has twice the destination's side (a level
+// that halves its resolution, issue 24). A destination texel's centre is a
+// source texel corner, so a tap at o destination texels reads source texels at
+// 2o ± ½ and has second moment ((n − ½)² + 2n·f)/4 with 2o + ½ = n + f: the
+// centre tap is the 2×2 box, of variance BOX. The stencil is the 5×5 of Σ − BOX
+// on each axis, its side taps moved to where they hold their moment plus BOX,
+// so the total is Σ again (a per-axis variance below BOX stays BOX).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(constant_id = 0) const bool FIVE = false;
+layout(constant_id = 1) const bool HALF = false;
 layout(binding = 0) uniform sampler2D src;
 layout(binding = 1) uniform sampler2D stretch;
 layout(binding = 2, rgba16f) uniform writeonly image2D dst;
@@ -36,6 +45,24 @@ layout(push_constant) uniform Push { float sigma_mm; } pc;
 float tap_offset(float m) {
     float n = floor(sqrt(m));
     return n + (m - n * n) / (2.0 * n + 1.0);
+}
+
+// The second moment of a same-size tap at o: tap_offset's inverse.
+float tap_moment(float o) {
+    float n = floor(o);
+    return n * n + (o - n) * (2.0 * n + 1.0);
+}
+
+// The box of a HALF pass's centre tap, destination texels² per axis
+// (skin::chain::HALF_BOX_TEXELS2).
+const float BOX = HALF ? 1.0 / 16.0 : 0.0;
+
+// The offset o (destination texels) of a HALF pass's tap whose second moment
+// is m ≥ BOX: ((n − ½)² + 2n·f)/4 = m at 2o + ½ = n + f, n ≥ 1.
+float half_tap_offset(float m) {
+    float s = 4.0 * max(m, BOX);
+    float n = max(floor(sqrt(s) + 0.5), 1.0);
+    return 0.5 * (n + (s - (n - 0.5) * (n - 0.5)) / (2.0 * n) - 0.5);
 }
 
 // The 5×5 stencil along one axis, variance m: (h, D), the weight of each side's
@@ -67,7 +94,11 @@ void main() {
     float x = v * (s.x * s.x + s.z * s.z), y = v * s.y * s.y, xy = v * s.z * s.y;
     vec4 sum;
     if (FIVE) {
-        vec2 tx = five_taps(x), ty = five_taps(y);
+        vec2 tx = five_taps(max(x - BOX, 0.0)), ty = five_taps(max(y - BOX, 0.0));
+        if (HALF) {
+            tx.y = half_tap_offset(tap_moment(tx.y) + BOX);
+            ty.y = half_tap_offset(tap_moment(ty.y) + BOX);
+        }
         vec2 dx = vec2(tx.y * texel.x, 0.0), dy = vec2(0.0, ty.y * texel.y);
         // k on the corners: the tensor product's 4·hx·hy, or up to 2·min(hx, hy)
         // (all the side weight) where the cross moment k·γ·Dx·Dy needs more.

@@ -49,6 +49,9 @@ layout(push_constant) uniform Push {
 // The pass is built with the transmitted term (skin::shade::ShadePass::new);
 // without it the shader is the one without the term.
 layout(constant_id = 5) const bool TRANSMISSION = false;
+// With blur_amount < 1 the unblurred irradiance is mixed in; at 1 (the
+// default) the pass is built without its lookup (skin::shade::ShadePass::new).
+layout(constant_id = 6) const bool UNBLURRED = true;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -103,7 +106,7 @@ void main() {
     vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
                  + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
                  + pc.weights[4].rgb * lookup(blur5) + pc.weights[5].rgb * lookup(blur6);
-    vec3 diffuse = mix(lookup(irradiance), blurred, pc.blur_amount);
+    vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.

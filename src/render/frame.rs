@@ -272,7 +272,7 @@ impl Passes {
             )?,
             irradiance: IrradiancePass::new(p, variant)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
-            shade: ShadePass::new(p, variant, skin.transmission > 0.0)?,
+            shade: ShadePass::new(p, variant, skin.transmission > 0.0, skin.blur_amount < 1.0)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,
             prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,

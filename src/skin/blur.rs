@@ -4,7 +4,8 @@
 //! may be coarser than their predecessor (skin::chain): the U pass then writes
 //! the new width, the V pass the new height. A level whose σ spans about a
 //! texel or less (chain::Stencil) is blurred in one pass, `blurK`, by a 3×3 or
-//! 5×5 stencil of its covariance (blur_narrow.comp), whichever kernel is chosen.
+//! 5×5 stencil of its covariance (blur_narrow.comp), whichever kernel is chosen;
+//! so is a narrow level that halves its predecessor's side (5×5 only).
 //!
 //! Every UV target is coverage-premultiplied (alpha = 1 on the mesh, 0 in the
 //! gutter), so the chain is a plain linear convolution of (I·a, a) and dividing by
@@ -45,6 +46,8 @@ pub struct BlurChain {
     /// Both directions of a narrow Gaussian (blur_narrow.comp), indexed by
     /// `Stencil as usize`, which is also the shader's FIVE constant.
     narrow: [Arc<Pipeline>; 2],
+    /// The 5×5 stencil from a source of twice the side (HALF).
+    narrow_halving: Arc<Pipeline>,
     taps: Arc<Buffer>,
     sampler: Arc<Sampler>,
     /// The stretch maps hold the shear (skin.shear_correction): the V pass
@@ -81,9 +84,10 @@ impl BlurChain {
         Ok(Self {
             pipeline: pipelines.compute("blur.comp", &[tap_count])?,
             narrow: [
-                pipelines.compute("blur_narrow.comp", &[Stencil::Three as u32])?,
-                pipelines.compute("blur_narrow.comp", &[Stencil::Five as u32])?,
+                pipelines.compute("blur_narrow.comp", &[Stencil::Three as u32, 0])?,
+                pipelines.compute("blur_narrow.comp", &[Stencil::Five as u32, 0])?,
             ],
+            narrow_halving: pipelines.compute("blur_narrow.comp", &[Stencil::Five as u32, 1])?,
             taps: upload_buffer(
                 ctx,
                 "blur kernel",
@@ -180,7 +184,8 @@ impl BlurChain {
     }
 
     /// One narrow Gaussian of σ mm over `stencil`, both directions in one pass
-    /// `name`, from `src` into `dst` of the same size (blur_narrow.comp).
+    /// `name`, from `src` into `dst` of the same size or, with the 5×5
+    /// stencil, half of it (blur_narrow.comp).
     pub fn narrow(
         &self,
         g: &mut Graph,
@@ -191,7 +196,13 @@ impl BlurChain {
         dst: &mut ImageHandle,
     ) {
         let (w, h) = (dst.desc.width, dst.desc.height);
-        g.simple_pass(name, &self.narrow[stencil as usize])
+        let pipeline = if src.desc.width == w {
+            &self.narrow[stencil as usize]
+        } else {
+            assert!(stencil == Stencil::Five && src.desc.width == 2 * w);
+            &self.narrow_halving
+        };
+        g.simple_pass(name, pipeline)
             .tag(super::TAG)
             .sample(src, &self.sampler)
             .sample(stretch, &self.sampler)

@@ -6,7 +6,10 @@
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
 //! first term). docs/performance.md shows what it costs and how far it is off.
 //! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
-//! of its source's resolution is blurred in one pass instead of two (issue 24).
+//! of its source's resolution is blurred in one pass instead of two (issue 24);
+//! so is a level that halves its source's side, with the 5×5 stencil, where
+//! its σ spans at most that in texels of its own resolution beyond the 2×2 box
+//! its centre tap reads.
 
 use super::profile::Profile;
 use crate::scene::file::Chain;
@@ -21,8 +24,13 @@ pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 pub const SKIP_SIGMA_TEXELS: f32 = 2.0;
 /// The coarsest level the adaptive chain goes down to.
 pub const MIN_RESOLUTION: u32 = 64;
+/// Variance per axis, in texels² of a level that halves its source's side,
+/// of a bilinear tap at a texel centre of the level: the 2×2 box of the source
+/// texels it covers (blur_narrow.comp's BOX).
+pub const HALF_BOX_TEXELS2: f32 = 1.0 / 16.0;
 /// The texel neighbourhood of a level blurred in one pass (blur_narrow.comp),
-/// both directions at once, from a source of its own resolution.
+/// both directions at once, from a source of its own resolution (or, the 5×5
+/// only, of twice it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stencil {
     /// 3×3, four bilinear taps: per axis the tent m/2, 1 − m, m/2 of variance
@@ -44,8 +52,18 @@ impl Stencil {
         }
     }
 
-    /// The smallest stencil for a blur of `sigma_texels`; `None`: two passes.
-    fn for_sigma(sigma_texels: f32) -> Option<Self> {
+    /// The smallest stencil for a blur of `sigma_texels` (at the level's
+    /// resolution) from a source of the same side, or only the 5×5 from one
+    /// of twice the side (`halves`: blur_narrow.comp's HALF, whose centre tap,
+    /// a 2×2 box of the source, holds [`HALF_BOX_TEXELS2`] of the variance
+    /// and the stencil the rest); `None`: two passes.
+    fn for_sigma(sigma_texels: f32, halves: bool) -> Option<Self> {
+        if halves {
+            let stencil = (sigma_texels * sigma_texels - HALF_BOX_TEXELS2)
+                .max(0.0)
+                .sqrt();
+            return (stencil <= Stencil::Five.max_sigma_texels()).then_some(Stencil::Five);
+        }
         [Stencil::Three, Stencil::Five]
             .into_iter()
             .find(|s| sigma_texels <= s.max_sigma_texels())
@@ -61,8 +79,9 @@ pub struct Level {
     /// the level is the previous image, unblurred (an adaptive first level under
     /// [`SKIP_SIGMA_TEXELS`], or any level of a profile scaled to zero width).
     pub sigma_mm: Option<f32>,
-    /// The blur is narrow and keeps the previous image's resolution: one pass,
-    /// both directions, over this stencil (skin::blur); `None`: U then V.
+    /// The blur is narrow and keeps the previous image's resolution or halves
+    /// it: one pass, both directions, over this stencil (skin::blur); `None`:
+    /// U then V.
     pub one_pass: Option<Stencil>,
 }
 
@@ -100,8 +119,8 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
             resolution: side,
             sigma_mm,
             one_pass: sigma_mm
-                .filter(|_| side == previous_resolution)
-                .and_then(|s| Stencil::for_sigma(texels(s))),
+                .filter(|_| side == previous_resolution || 2 * side == previous_resolution)
+                .and_then(|s| Stencil::for_sigma(texels(s), side < previous_resolution)),
         };
         if level.sigma_mm.is_some() {
             previous_variance = g.variance_mm2;
@@ -194,7 +213,8 @@ mod tests {
     #[test]
     fn narrow_levels_at_their_source_resolution_are_one_pass() {
         // The scan at 1024² (1.62 texels/mm): σ increments of levels 2-4 are
-        // 0.36, 0.60 and 1.00 texels; 5 and 6 halve the resolution.
+        // 0.36, 0.60 and 1.00 texels; 5 and 6 halve the resolution, with
+        // increments of 0.97 and 0.94 texels of their own.
         let stencils: Vec<Option<Stencil>> = plan(&Profile::skin(), Chain::Adaptive, 1024, 1.62)
             .iter()
             .map(|l| l.one_pass)
@@ -202,12 +222,26 @@ mod tests {
         use Stencil::*;
         assert_eq!(
             stencils,
-            [None, Some(Three), Some(Three), Some(Five), None, None]
+            [
+                None,
+                Some(Three),
+                Some(Three),
+                Some(Five),
+                Some(Five),
+                Some(Five)
+            ]
         );
         // At 4096² (6.46 texels/mm) level 2 is 1.42 texels: two passes.
-        assert!(plan(&Profile::skin(), Chain::Adaptive, 4096, 6.46)
+        // Level 3 halves to 2048² with 1.202 texels, 1.176 beyond the box of
+        // its centre tap; levels 4-6 halve with under a texel.
+        let stencils: Vec<Option<Stencil>> = plan(&Profile::skin(), Chain::Adaptive, 4096, 6.46)
             .iter()
-            .all(|l| l.one_pass.is_none()));
+            .map(|l| l.one_pass)
+            .collect();
+        assert_eq!(
+            stencils,
+            [None, None, Some(Five), Some(Five), Some(Five), Some(Five)]
+        );
     }
 
     #[test]

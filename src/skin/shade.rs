@@ -93,17 +93,26 @@ pub struct ShadePass {
     pipeline: Arc<Pipeline>,
 }
 
-/// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's.
+/// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
+/// `UNBLURRED`.
 const TRANSMISSION_CONSTANT: usize = 5;
 
 impl ShadePass {
     /// `transmission`: build the final pass with the transmitted term (a
     /// specialization constant: without it the shader is the one without the
     /// term, so `skin.transmission = 0` costs nothing and changes no bit).
-    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, transmission: bool) -> Result<Self> {
+    /// `unblurred`: with the unblurred irradiance mixed in (`skin.blur_amount`
+    /// < 1; at 1 its lookup would be multiplied by 0).
+    pub fn new(
+        pipelines: &Pipelines,
+        variant: &ShaderVariant,
+        transmission: bool,
+        unblurred: bool,
+    ) -> Result<Self> {
         let mut specialization = variant.specialization().to_vec();
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
+        specialization.push(u32::from(unblurred));
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
