@@ -66,14 +66,16 @@ float half_tap_offset(float m) {
 }
 
 // The 5×5 stencil along one axis, variance m: (h, D), the weight of each side's
-// tap at ±D (1 − 2h on the centre). Where the Gaussian's ratio would leave the
-// centre negative (m above ≈ 1.9) the centre is 0 and D carries the variance:
-// h·(1 + 3t) = m/2 at D = 1 + t.
+// tap at ±D (1 − 2h on the centre): h·(1 + 3t) = m/2 at D = 1 + t. Where that
+// would put more than a third on each side (m above ≈ 1.05 texel², the stretch
+// far above the mesh's mean), three equal taps, the sides at the bilinear
+// offset whose moment holds the variance (continuous at the switch), so the
+// centre never empties into a ring.
 vec2 five_taps(float m) {
     float r = exp(-1.5 / max(m, 1e-6));
     float t = r / (1.0 + r);
     float h = m / (2.0 + 6.0 * t);
-    return h <= 0.5 ? vec2(h, 1.0 + t) : vec2(0.5, 1.0 + (m - 1.0) / 3.0);
+    return h <= 1.0 / 3.0 ? vec2(h, 1.0 + t) : vec2(1.0 / 3.0, tap_offset(1.5 * m));
 }
 
 vec4 at(vec2 uv, vec2 offset) {

@@ -37,7 +37,8 @@ pub enum Stencil {
     /// m = σ², highest at the centre up to m = 2/3.
     Three,
     /// 5×5, nine bilinear taps: per axis weights at 0, ±1, ±2 texels in the
-    /// Gaussian's ratio, with a centre weight up to m ≈ 1.9.
+    /// Gaussian's ratio up to m ≈ 1.05, above it (the stretch above the mean)
+    /// three equal weights per axis, the sides where they hold m.
     Five,
 }
 
