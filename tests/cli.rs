@@ -860,12 +860,20 @@ fn precompute_fills_the_cache_and_reports_time() {
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("vertices") && stdout.contains(" s ("),
+        stdout.contains("vertices")
+            && stdout.contains(" s (")
+            && stdout.contains("interreflection: ")
+            && stdout.contains("environment transmission: "),
         "{stdout}"
     );
-    let files = std::fs::read_dir(&cache).unwrap().count();
-    assert_eq!(files, 1, "one cached transfer");
+    let files = || std::fs::read_dir(&cache).unwrap().count();
+    assert_eq!(
+        files(),
+        3,
+        "the occlusion, interreflected and transmitted transfers"
+    );
     assert!(run().status.success(), "second run reads the cache");
+    assert_eq!(files(), 3, "and writes nothing new");
     let out = dermis(&["precompute", "--occlusion", "sideways"]);
     assert_eq!(out.status.code(), Some(2));
 }
