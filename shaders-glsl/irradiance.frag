@@ -19,9 +19,10 @@ layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
-// The light the skin reflects onto itself (uv_lit.vert; lighting.glsl).
-layout(location = 7) in vec3 v_bounce;
-#define INTERREFLECTION
+// The light the skin reflects onto itself and the sky's through thin skin
+// (uv_lit.vert; lighting.glsl).
+layout(location = 7) in vec3 v_indirect;
+#define INDIRECT
 #define SPEC_BECKMANN 5
 #define SPEC_ALBEDO 6
 #define SPEC_REGIONS 7

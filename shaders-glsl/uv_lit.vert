@@ -23,7 +23,7 @@ layout(location = 3) out vec4 v_tangent;
 layout(location = 4) out vec3 v_t012;
 layout(location = 5) out vec3 v_t345;
 layout(location = 6) out vec3 v_t678;
-layout(location = 7) out vec3 v_bounce;
+layout(location = 7) out vec3 v_indirect;
 
 const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 
@@ -50,6 +50,6 @@ void main() {
         sh_basis(l, y);
         for (int j = 0; j < 9; ++j) L[j] += e * y[j];
     }
-    v_bounce = OCCLUSION ? rgb_transfer_irradiance(INTERREFLECTED, L) + through : vec3(0.0);
+    v_indirect = OCCLUSION ? rgb_transfer_irradiance(INTERREFLECTED, L) + through : vec3(0.0);
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
 }
