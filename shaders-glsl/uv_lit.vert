@@ -9,6 +9,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "sh_basis.glsl"
+#include "incident.glsl"
 #define RGB_TRANSFER 14
 #include "transfer.glsl"
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
@@ -25,8 +26,6 @@ layout(location = 5) out vec3 v_t345;
 layout(location = 6) out vec3 v_t678;
 layout(location = 7) out vec3 v_indirect;
 
-const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
-
 void main() {
     v_position = position;
     v_normal = normal;
@@ -37,15 +36,9 @@ void main() {
     for (int j = 0; j < 9; ++j) L[j] = lighting.sh[j].rgb;
     vec3 through = rgb_transfer_irradiance(TRANSMITTED, L);
     for (int i = 0; i < LIGHT_COUNT; ++i) {
-        vec4 lv = frame.light_vec[i];
-        vec3 e = frame.light_color[i].rgb;
-        vec3 l = lv.xyz;
-        if (lv.w > 0.5) {
-            vec3 d = lv.xyz - position;
-            float d2 = max(dot(d, d), 1e-6);
-            l = d * inversesqrt(d2);
-            e *= POINT_REFERENCE_MM * POINT_REFERENCE_MM / d2;
-        }
+        vec3 l;
+        float dist;
+        vec3 e = light_incident(i, position, l, dist);
         float y[9];
         sh_basis(l, y);
         for (int j = 0; j < 9; ++j) L[j] += e * y[j];

@@ -11,8 +11,8 @@
 // (shadow_thickness: transmission).
 // Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
+#include "incident.glsl"
 
-const float POINT_REFERENCE_MM = 1000.0;   // scene::POINT_LIGHT_REFERENCE_MM
 // Acne offsets, in shadow-map texels: along the normal (normal-offset shadows,
 // Holbert 2011) and towards the light (a constant depth bias in world units).
 // The PCF taps reach 2 texels from the lookup; a surface tilted θ from the light
@@ -238,25 +238,6 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
         }
     }
     return lit / 9.0;
-}
-
-// Irradiance light i delivers at x to a surface facing it, unshadowed (mirrors
-// scene::Light::at); l: the unit direction towards the light; dist: the
-// distance to a point light (1 for a directional one).
-vec3 light_incident(int i, vec3 x, out vec3 l, out float dist) {
-    vec4 lv = frame.light_vec[i];
-    vec3 e = frame.light_color[i].rgb;
-    dist = 1.0;
-    if (lv.w > 0.5) {
-        vec3 d = lv.xyz - x;
-        float d2 = max(dot(d, d), 1e-6);
-        dist = sqrt(d2);
-        l = d / dist;
-        e *= POINT_REFERENCE_MM * POINT_REFERENCE_MM / d2;
-    } else {
-        l = lv.xyz;
-    }
-    return e;
 }
 
 // Irradiance light i delivers at x (texture coordinate uv) to a surface facing

@@ -29,11 +29,12 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 use super::occlusion::{cache_key, rgb_cached};
 use super::occlusion::{directions, transfer_key, Bvh, RayOptions, RgbTransfer, Transfer};
+use super::reference::rgba8;
 use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
 use crate::scene::texture::Texture;
@@ -66,17 +67,13 @@ fn row(
         let Some(hit) = bvh.closest_hit(origin, w, f32::INFINITY) else {
             continue;
         };
-        let t = 3 * hit.triangle as usize;
-        let corners = [0, 1, 2].map(|k| mesh.indices[t + k] as usize);
-        let b = hit.barycentric.to_array();
-        let at_hit =
-            |f: &dyn Fn(usize) -> Vec3| (0..3).fold(Vec3::ZERO, |a, k| a + b[k] * f(corners[k]));
         // The hit's side facing the ray: the interpolated normal against it.
-        if at_hit(&|c| mesh.normals[c]).dot(w) >= 0.0 {
+        if hit.interpolate(mesh, &mesh.normals).dot(w) >= 0.0 {
             continue;
         }
-        let uv = (0..3).fold(Vec2::ZERO, |a, k| a + b[k] * mesh.uvs[corners[k]]);
-        let rho = albedo.linear_rgb_nearest(uv) / n as f32;
+        let (corners, b) = (hit.corners(mesh), hit.barycentric.to_array());
+        // The albedo as the GPU samples it there (bilinear, sRGB decoded).
+        let rho = rgba8(albedo, hit.interpolate(mesh, &mesh.uvs)).truncate() / n as f32;
         for k in 0..3 {
             row.push((corners[k] as u32, (rho * b[k]).to_array()));
         }
@@ -202,7 +199,7 @@ pub fn bounce_for(
         ..RayOptions::default()
     };
     let settings = format!(
-        "{} tolerance={TOLERANCE} direct={direct_key} albedo={:016x}",
+        "{} tolerance={TOLERANCE} albedo_lookup=bilinear direct={direct_key} albedo={:016x}",
         opts.cache_settings(),
         albedo_hash(albedo)
     );

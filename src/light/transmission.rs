@@ -68,11 +68,7 @@ fn vertex(
         let Some(hit) = bvh.closest_hit(origin, w, reach_mm(profile)) else {
             continue;
         };
-        let t = 3 * hit.triangle as usize;
-        let corners = [0, 1, 2].map(|k| mesh.indices[t + k] as usize);
-        let b = hit.barycentric.to_array();
-        let normal: Vec3 = (0..3).map(|k| b[k] * mesh.normals[corners[k]]).sum();
-        let Some(normal) = normal.try_normalize() else {
+        let Some(normal) = hit.interpolate(mesh, &mesh.normals).try_normalize() else {
             continue;
         };
         // Leaving the mesh there, on the far side.
@@ -84,6 +80,7 @@ fn vertex(
         // where the directions are drawn.
         let r = (origin + w * hit.t - p).length();
         let weight = profile.radial(r) * hit.t * hit.t / (cos_q.max(MIN_COS_Q) * w.dot(-nrm));
+        let (corners, b) = (hit.corners(mesh), hit.barycentric.to_array());
         for (c, row) in out.iter_mut().enumerate() {
             for (j, x) in row.iter_mut().enumerate() {
                 let tj: f32 = (0..3).map(|k| b[k] * direct.coeffs[corners[k]][j]).sum();

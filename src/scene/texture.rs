@@ -54,24 +54,6 @@ impl Texture {
         }
     }
 
-    /// Linear RGB of the texel nearest `uv` (wrapped; v down, row 0 at v = 0),
-    /// sRGB-decoded where the encoding says so: what a shader's nearest
-    /// lookup of the uploaded texture returns.
-    pub fn linear_rgb_nearest(&self, uv: glam::Vec2) -> glam::Vec3 {
-        let (w, h) = (self.width.max(1), self.height.max(1));
-        let x = ((uv.x.rem_euclid(1.0) * w as f32) as u32).min(w - 1);
-        let y = ((uv.y.rem_euclid(1.0) * h as f32) as u32).min(h - 1);
-        let t = 4 * (y * w + x) as usize;
-        let c = |k: usize| {
-            let b = self.rgba8.get(t + k).copied().unwrap_or(0);
-            match self.encoding {
-                Encoding::Srgb => srgb_to_linear(b),
-                Encoding::Linear => f32::from(b) / 255.0,
-            }
-        };
-        glam::Vec3::new(c(0), c(1), c(2))
-    }
-
     /// Reverses the row order: a map authored with its UV origin at the bottom
     /// left (OpenGL) becomes one sampled with glTF's top-left origin, since the
     /// texel for (u, v) moves from row (1 − v)·h to row v·h.
@@ -89,9 +71,8 @@ pub fn flip_rows<T>(pixels: &mut [T], row_len: usize) {
     }
 }
 
-/// IEC 61966-2-1 sRGB decoding of one 8-bit value.
-pub fn srgb_to_linear(c: u8) -> f32 {
-    let c = f32::from(c) / 255.0;
+/// IEC 61966-2-1 sRGB decoding of a value in [0, 1].
+pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
     } else {

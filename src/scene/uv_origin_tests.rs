@@ -153,7 +153,7 @@ fn lips_and_cheeks(scene: &Scene) -> (f32, f32) {
     let depth = |i: &usize| nose.z - mesh.positions[*i].z;
     assert!(lips.iter().all(|i| depth(i) < 25.0), "lips off the face");
     assert!(cheeks.iter().all(|i| depth(i) > 20.0), "no nose in front");
-    let albedo = Rgb::of(&scene.albedo, srgb_to_linear);
+    let albedo = Rgb::of(&scene.albedo, |c| srgb_to_linear(f32::from(c) / 255.0));
     (
         redness(&albedo, mesh, &lips),
         redness(&albedo, mesh, &cheeks),

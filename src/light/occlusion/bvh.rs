@@ -51,6 +51,26 @@ pub struct Hit {
     pub barycentric: Vec3,
 }
 
+impl Hit {
+    /// The mesh's vertices at the hit triangle's corners 0, 1, 2 (a hit of
+    /// [`Bvh::from_mesh`]).
+    pub fn corners(&self, mesh: &Mesh) -> [usize; 3] {
+        let k = 3 * self.triangle as usize;
+        [0, 1, 2].map(|c| mesh.indices[k + c] as usize)
+    }
+
+    /// A per-vertex attribute of the mesh at the hit, barycentrically
+    /// interpolated (as a rasteriser interpolates it).
+    pub fn interpolate<T>(&self, mesh: &Mesh, values: &[T]) -> T
+    where
+        T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+    {
+        let [a, b, c] = self.corners(mesh);
+        let w = self.barycentric;
+        values[a] * w.x + values[b] * w.y + values[c] * w.z
+    }
+}
+
 /// Leaves hold at most this many triangles unless the centroids coincide.
 const MAX_LEAF: usize = 4;
 /// Depth cap: the traversal stack holds `MAX_DEPTH + 1` entries at most.

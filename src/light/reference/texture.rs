@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::scene::env::EnvMap;
-use crate::scene::texture::{Encoding, Texture};
+use crate::scene::texture::{srgb_to_linear, Encoding, Texture};
 
 /// RGBA of an 8-bit texture at `uv` (linear values; alpha is never sRGB).
 pub fn rgba8(t: &Texture, uv: Vec2) -> Vec4 {
@@ -45,15 +45,6 @@ pub fn bilinear(width: u32, height: u32, uv: Vec2, fetch: impl Fn(u32, u32) -> V
     let top = fetch(x0, y0).lerp(fetch(x1, y0), f.x);
     let bottom = fetch(x0, y1).lerp(fetch(x1, y1), f.x);
     top.lerp(bottom, f.y)
-}
-
-/// IEC 61966-2-1 decoding.
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 #[cfg(test)]
