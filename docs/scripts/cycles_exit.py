@@ -54,7 +54,8 @@ class ExitTable:
     Lambertian albedo in, Cycles' radiance over it out)."""
 
     def __init__(self, path, mu_ends):
-        t = json.load(open(path))
+        with open(path) as f:
+            t = json.load(f)
         self.base = np.asarray(t["base"], np.float64)
         self.mu = np.asarray(t["mu"], np.float64)
         self.radiance = np.asarray(t["radiance"], np.float64)  # [mu][base]
@@ -123,14 +124,19 @@ def main():
     view = camera - pos[mask]
     view /= np.linalg.norm(view, axis=-1, keepdims=True)
     mu = (images["normals"][mask] * view).sum(-1)
-    r = ExitTable(args.exit_table, args.mu_ends).ratio(albedo, np.repeat(mu[:, None], 3, 1))
+    table = ExitTable(args.exit_table, args.mu_ends)
+    r = table.ratio(albedo, np.repeat(mu[:, None], 3, 1))
 
     predicted = s + (d - s) * r  # Cycles, if dermis's exit were Lambertian
     corrected = s + (c - s) / r  # Cycles put back on a Lambertian exit
     floor = 0.1 * cc.luminance(c).mean()
     _, groups = cc.region_groups(pos[mask] - cc.NOSE_TIP_MM)
-    result = {"pixels": int(mask.sum()), "mu_below_first_node": float((mu < 0.0694).mean()),
-              "mu_above_last_node": float((mu > 0.9306).mean()), "groups": {}}
+    result = {
+        "pixels": int(mask.sum()),
+        "mu_below_first_node": float((mu < table.mu[0]).mean()),
+        "mu_above_last_node": float((mu > table.mu[-1]).mean()),
+        "groups": {},
+    }
     for name, g in groups.items():
         if g.sum() == 0:
             continue
