@@ -92,6 +92,23 @@ def extra_groups(d):
     }
 
 
+def covered(dermis, ref):
+    """The pixels both images cover fully: Cycles alpha > 0.999, dermis alpha > 0.5."""
+    return (ref[..., 3] > 0.999) & (dermis[..., 3] > 0.5)
+
+
+def region_groups(offset):
+    """The landmark region id per pixel and the named groups of pixels (boolean
+    masks): mesh, face, the landmark regions and extra_groups', from the surface
+    points' offset (N, 3) in mm from the nose tip."""
+    region = landmark_region(offset)
+    groups = {"mesh": np.ones(len(offset), bool), "face": region < LANDMARK_NAMES.index("ears")}
+    for i, name in enumerate(LANDMARK_NAMES):
+        groups[name] = region == i
+    groups.update(extra_groups(offset))
+    return region, groups
+
+
 def read_dermis(path):
     """dermis's EXR (RGBA), or a Cycles one (Combined), to compare two variants."""
     ch = OpenEXR.File(path).parts[0].channels
@@ -205,7 +222,7 @@ def main():
             p.error(f"sizes differ: dermis {dermis.shape[:2]}, Cycles {rgba.shape[:2]}")
     ref = np.mean([r for r, _ in refs], 0)
     pos = refs[0][1]
-    mask = (ref[..., 3] > 0.999) & (dermis[..., 3] > 0.5)
+    mask = covered(dermis, ref)
     coverage_iou = float(
         ((ref[..., 3] > 0.5) & (dermis[..., 3] > 0.5)).sum()
         / ((ref[..., 3] > 0.5) | (dermis[..., 3] > 0.5)).sum()
@@ -213,11 +230,7 @@ def main():
     d, r = dermis[mask][:, :3], ref[mask][:, :3]
     floor = 0.1 * luminance(r).mean()
     offset = pos[mask] - NOSE_TIP_MM
-    region = landmark_region(offset)
-    groups = {"mesh": np.ones(len(d), bool), "face": region < LANDMARK_NAMES.index("ears")}
-    for i, name in enumerate(LANDMARK_NAMES):
-        groups[name] = region == i
-    groups.update(extra_groups(offset))
+    region, groups = region_groups(offset)
     if args.unlit:
         unlit_image = read_dermis(args.unlit)
         if unlit_image.shape != dermis.shape:

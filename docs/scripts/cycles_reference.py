@@ -13,7 +13,8 @@ conserving dielectric layer over the base) with random-walk subsurface
 scattering at Jensen et al. 2001's skin1 diffuse mean free paths; the camera
 and environment of assets/default.toml. Output: a multilayer linear EXR
 (Standard view transform, no denoising), layers Combined (alpha = coverage) and
-Position (world, Blender units, Z up), written to a temporary file and renamed.
+Position (world, Blender units, Z up), with --normal-pass also Normal, written
+to a temporary file and renamed.
 """
 
 import argparse
@@ -135,6 +136,13 @@ def parse_args(argv):
         choices=["final", "albedo"],
         default="final",
         help="albedo: the albedo map as emission (to check the UVs)",
+    )
+    p.add_argument(
+        "--normal-pass",
+        action="store_true",
+        help="also write the Normal pass (world, Blender axes): the shading normal "
+        "the closures use, the normal map's included (docs/scripts/cycles_exit.py "
+        "takes the exit cosine from it)",
     )
     args = p.parse_args(argv)
     if not args.out.lower().endswith(".json" if args.slab_reflectance else ".exr"):
@@ -420,6 +428,7 @@ def main():
     scene.render.use_compositing = False
     scene.render.use_sequencer = False
     scene.view_layers[0].use_pass_position = True
+    scene.view_layers[0].use_pass_normal = args.normal_pass
     settings = scene.render.image_settings
     settings.file_format = "OPEN_EXR_MULTILAYER"
     settings.color_depth = "32"
