@@ -2,20 +2,20 @@
 // Irradiance in texture space (GPU Gems 3 §14.5): SH environment irradiance
 // (Ramamoorthi & Hanrahan 2001) plus the explicit lights (shadowed), less what the
 // specular reflects (energy conservation on entry), times the pre-scatter
-// albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter).
+// albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter). The shading
+// normal, albedo^mix and (ρs, m) were drawn once per render by surface.frag over
+// this same raster and are read texel for texel.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "sh.glsl"
-layout(binding = 1) uniform sampler2D albedo_tex;
-layout(binding = 2) uniform sampler2D normal_tex;
-layout(push_constant) uniform Push { float mix_pre; } pc;
+layout(binding = 1) uniform sampler2D surface_normal_rho;
+layout(binding = 2) uniform sampler2D surface_albedo_m;
 // SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
 // (rgb), rotated and scaled by the environment intensity.
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
-layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
@@ -29,7 +29,6 @@ layout(location = 7) in vec3 v_indirect;
 #define SPEC_INTENSITY 8
 #define SPEC_ROUGHNESS 9
 #include "ks_specular.glsl"
-#include "normal_map.glsl"
 #define SHADOW_ATLAS 10
 #define SOFT_VISIBILITY 11
 #include "lights.glsl"
@@ -38,8 +37,9 @@ layout(location = 7) in vec3 v_indirect;
 layout(location = 0) out vec4 irradiance;
 
 void main() {
-    vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, specular_params(v_uv));
-    vec3 albedo = texture(albedo_tex, v_uv).rgb;
-    irradiance = vec4(e * pow(albedo, vec3(pc.mix_pre)), 1.0);
+    ivec2 texel = ivec2(gl_FragCoord.xy);
+    vec4 n = texelFetch(surface_normal_rho, texel, 0);
+    vec4 a = texelFetch(surface_albedo_m, texel, 0);
+    vec3 e = irradiance_at(v_position, v_normal, normalize(n.xyz), v_uv, vec2(n.w, a.w));
+    irradiance = vec4(e * a.rgb, 1.0);
 }

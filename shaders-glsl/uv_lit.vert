@@ -20,7 +20,6 @@ layout(location = 3) in vec4 tangent;
 layout(location = 0) out vec3 v_position;
 layout(location = 1) out vec3 v_normal;
 layout(location = 2) out vec2 v_uv;
-layout(location = 3) out vec4 v_tangent;
 layout(location = 4) out vec3 v_t012;
 layout(location = 5) out vec3 v_t345;
 layout(location = 6) out vec3 v_t678;
@@ -30,7 +29,6 @@ void main() {
     v_position = position;
     v_normal = normal;
     v_uv = uv;
-    v_tangent = tangent;
     load_transfer(v_t012, v_t345, v_t678);
     vec3 L[9];
     for (int j = 0; j < 9; ++j) L[j] = lighting.sh[j].rgb;

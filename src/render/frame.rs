@@ -270,7 +270,7 @@ impl Passes {
                 constant_stretch,
                 skin.shear_correction,
             )?,
-            irradiance: IrradiancePass::new(p, variant)?,
+            irradiance: IrradiancePass::new(p, variant, res)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(p, variant, skin.transmission > 0.0, skin.blur_amount < 1.0)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
@@ -574,7 +574,6 @@ impl Frame {
             &self.tables,
             &light.sh,
             (&light.shadows, &light.soft),
-            self.skin.resolution,
             self.skin.mix,
         );
         if self.ruler {

@@ -1,34 +1,64 @@
 //! Irradiance in texture space (GPU Gems 3 §14.5): the mesh rasterised by its
-//! UVs, lit by the SH environment and the shadowed explicit lights, times albedo^mix.
+//! UVs, lit by the SH environment and the shadowed explicit lights, times
+//! albedo^mix. What no light changes — the normal-mapped shading normal,
+//! albedo^mix and the specular's (ρs, m) — is drawn once per render over the
+//! same raster (`surface`, kept: the mesh, its maps and the skin settings are
+//! fixed for a render) and read back texel for texel by every frame
+//! (`irradiance`), instead of five map and table fetches per texel (issue 24;
+//! docs/performance.md).
 
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant};
-use crate::gpu::{ImageDesc, Pipeline, Pipelines};
-use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
+use crate::frame::{FrameInputs, ShaderVariant, Vertex};
+use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
+use crate::graph::{Access, BufferHandle, Graph, ImageHandle, Imported, LoadOp};
+use ash::vk;
 use std::sync::Arc;
+
+/// The surface textures (surface.frag): (n, ρs) and (albedo^mix, m).
+const SURFACE: [&str; 2] = ["surface_normal", "surface_albedo"];
 
 pub struct IrradiancePass {
     pipeline: Arc<Pipeline>,
+    surface_pipeline: Arc<Pipeline>,
+    /// [`SURFACE`] at the irradiance resolution, UV_FORMAT (RGBA16F, as the
+    /// irradiance it feeds).
+    surface: [Arc<Image>; 2],
 }
 
 impl IrradiancePass {
-    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant) -> Result<Self> {
+    /// The pass for an irradiance texture of `resolution`².
+    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, resolution: u32) -> Result<Self> {
+        let ctx = pipelines.ctx();
+        let specialization = variant.specialization();
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let desc = ImageDesc::new(resolution, resolution, UV_FORMAT);
+        let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
         Ok(Self {
-            pipeline: uv_pipeline(
-                pipelines,
-                "uv_lit.vert",
-                "irradiance.frag",
-                &variant.specialization(),
-            )?,
+            pipeline: uv_pipeline(pipelines, "uv_lit.vert", "irradiance.frag", &specialization)?,
+            surface_pipeline: pipelines.graphics(&GraphicsDesc {
+                vertex: "uv.vert",
+                fragment: "surface.frag",
+                color_formats: &[UV_FORMAT; 2],
+                depth_format: None,
+                depth_write: true,
+                vertex_layout: Some(Vertex::layout()),
+                // UV charts may be mirrored: both windings are surface.
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &specialization,
+                alpha_blend: false,
+            })?,
+            surface: [image(SURFACE[0])?, image(SURFACE[1])?],
         })
     }
 
     /// `sh`: the environment's coefficients (light::sh_pass); `shadows`: the
     /// lights' shadow atlas (light::shadow) and `soft`, the soft lights'
     /// visibility (light::visibility); `tables`: the specular term's, for energy
-    /// conservation on entry.
+    /// conservation on entry and the region parameters.
     #[allow(clippy::too_many_arguments)]
     pub fn pass(
         &self,
@@ -37,19 +67,40 @@ impl IrradiancePass {
         tables: &SpecularTables,
         sh: &BufferHandle,
         (shadows, soft): (&ImageHandle, &[ImageHandle]),
-        resolution: u32,
         mix: f32,
     ) -> ImageHandle {
-        let mut out = g.create_image(
-            "irradiance",
-            ImageDesc::new(resolution, resolution, UV_FORMAT),
-        );
         let s = &inputs.samplers;
+        let mut draw = false;
+        let mut surface: [ImageHandle; 2] = std::array::from_fn(|k| {
+            let (image, stale) = g.import_kept_image(
+                SURFACE[k],
+                Imported::Image(self.surface[k].clone()),
+                Access::ShaderSampled,
+                0,
+            );
+            draw |= stale;
+            image
+        });
+        if draw {
+            let pass = g
+                .simple_pass("surface", &self.surface_pipeline)
+                .uniform(&inputs.uniforms)
+                .texture(&inputs.albedo, &s.linear)
+                .texture(&inputs.normal, &s.linear);
+            let [normal, albedo] = &mut surface;
+            let pass = tables
+                .bind(pass, inputs)
+                .color(normal, LoadOp::Clear([0.0; 4]))
+                .color(albedo, LoadOp::Clear([0.0; 4]))
+                .constants(&mix);
+            inputs.mesh.draw(pass);
+        }
+        let mut out = g.create_image("irradiance", self.surface[0].desc);
         let pass = g
             .simple_pass("irradiance", &self.pipeline)
             .uniform(&inputs.uniforms)
-            .texture(&inputs.albedo, &s.linear)
-            .texture(&inputs.normal, &s.linear)
+            .sample(&surface[0], &s.nearest)
+            .sample(&surface[1], &s.nearest)
             .read_uniform(sh)
             .buffer(&inputs.transfer);
         let mut pass = tables.bind(pass, inputs).sample(shadows, &s.shadow);
@@ -58,8 +109,7 @@ impl IrradiancePass {
         }
         let pass = pass
             .buffer(&inputs.rgb_transfer)
-            .color(&mut out, LoadOp::Clear([0.0; 4]))
-            .constants(&mix);
+            .color(&mut out, LoadOp::Clear([0.0; 4]));
         inputs.mesh.draw(pass);
         out
     }
