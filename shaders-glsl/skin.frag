@@ -5,7 +5,8 @@
 // Plus the KS specular (the paper's eq. 1) of the explicit lights and of the
 // environment (split sum: ρs·A(N·V, m) × the KS-prefiltered environment).
 // With TRANSMISSION, the light of shadowed lights behind the skin transmitted
-// through it adds to the diffuse (docs/skin.md, "Transmission").
+// through it adds to the diffuse (docs/skin.md, "Transmission"), from the
+// texture translucent.frag drew once per lighting for the side shaded.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "envmap.glsl"
@@ -13,9 +14,11 @@ layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 #define SHADOW_ATLAS 3
 #define SOFT_VISIBILITY 18
-// Bindings 18..20: the soft lights' visibility; 21: the shadow atlas's depths.
-#define SHADOW_DEPTH 21
+// Bindings 18..20: the soft lights' visibility.
 #include "lights.glsl"
+// The light transmitted through thin skin, front and back (skin/translucent.rs).
+layout(binding = 21) uniform sampler2D translucent_front;
+layout(binding = 22) uniform sampler2D translucent_back;
 // binding 4: the per-vertex transfer, read by mesh_lit.vert.
 #define ENV_SPECULAR 5
 #include "env_specular.glsl"
@@ -34,8 +37,7 @@ layout(binding = 12) uniform sampler2D blur6;
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "visibility.glsl"
-// weights: rgb the Gaussians' weights, w their variances (mm², for the
-// transmittance). mode: 0 final, 1 diffuse only, 2 specular only, 3 the
+// weights: rgb the Gaussians' weights (w: padding). mode: 0 final, 1 diffuse only, 2 specular only, 3 the
 // transmitted light only. blur_amount: the share of the blurred levels, the
 // rest the unblurred irradiance (the paper's menu). transmission: the scale on
 // the transmitted light (skin.transmission).
@@ -67,41 +69,6 @@ vec3 lookup(sampler2D t) {
     return b.rgb / max(b.a, 1e-4);
 }
 
-// T(d) = Σ wᵢ exp(−d²/2vᵢ): the profile through a slab d mm thick, per channel
-// (G(v, √(r² + d²)) = G(v, r)·exp(−d²/2v); skin::profile::Profile::transmittance).
-vec3 transmittance(float d) {
-    vec3 t = vec3(0.0);
-    for (int k = 0; k < 6; ++k) {
-        float v = pc.weights[k].w;
-        float keep = v > 0.0 ? exp(-d * d / (2.0 * v)) : (d <= 0.0 ? 1.0 : 0.0);
-        t += pc.weights[k].rgb * keep;
-    }
-    return t;
-}
-
-// Irradiance the skin at x transmits from the shadowed lights behind it
-// (Jimenez et al. 2010; d'Eon & Luebke §14.5.3): for each light the shaded
-// side faces away from (geometric normal ng towards the viewer: dot(ng, l) < 0,
-// so a lit face, whose thickness is ≈ 0, is not lit twice), the light's
-// irradiance on the light-facing surface — its normal taken as −n, the
-// light entering less what the specular reflects there (x's own ρs, m) —
-// through the thickness the shadow map gives, × skin.transmission.
-vec3 transmitted(vec3 x, vec3 ng, vec3 n, vec2 params) {
-    vec3 sum = vec3(0.0);
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
-        if ((SHADOWED_LIGHTS & (1 << i)) == 0) continue;
-        vec3 l;
-        float dist;
-        vec3 e = light_incident(i, x, l, dist);
-        if (dot(ng, l) >= 0.0) continue;
-        float back = max(dot(-n, l), 0.0);
-        if (back <= 0.0) continue;
-        back *= diffuse_transmission(back, light_lobe(i, params));
-        sum += e * back * transmittance(shadow_thickness(i, x, dist));
-    }
-    return sum * pc.transmission;
-}
-
 void main() {
     vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
                  + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
@@ -110,7 +77,8 @@ void main() {
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.
-    if (dot(v_normal, v) < 0.0) n = -n;
+    bool back_side = dot(v_normal, v) < 0.0;
+    if (back_side) n = -n;
     vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
@@ -128,8 +96,8 @@ void main() {
     // irradiance does (x's own albedo for the far side's).
     vec3 through = vec3(0.0);
     if (TRANSMISSION) {
-        vec3 ng = dot(v_normal, v) < 0.0 ? -v_normal : v_normal;
-        through = transmitted(v_position, ng, n, params) * pow(albedo, vec3(pc.mix_pre));
+        through = (back_side ? lookup(translucent_back) : lookup(translucent_front))
+                * pc.transmission * pow(albedo, vec3(pc.mix_pre));
         diffuse += through;
     }
     vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit;

@@ -6,9 +6,9 @@
 // space by light_visibility.frag (light/visibility.rs), which defines
 // SHADOW_DEPTH (the atlas again, nearest, no comparison), and read back by the
 // shading passes, which define SOFT_VISIBILITY: the first of three bindings of
-// the visibility textures, three lights each, coverage-premultiplied. The final
-// skin pass defines SHADOW_DEPTH too, for the thickness light passes through
-// (shadow_thickness: transmission).
+// the visibility textures, three lights each, coverage-premultiplied.
+// translucent.frag defines SHADOW_DEPTH too, for the thickness light passes
+// through (shadow_thickness: transmission).
 // Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
 #include "incident.glsl"
@@ -176,7 +176,7 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 // is dist·(1 − axial(stored)/axial(x)), dist = |light − x|
 // (light::shadow::ShadowView::thickness_mm mirrors this). From the whole-mesh
 // map: the profile's transmittance changes over millimetres, its 0.33 mm texels
-// do, and choosing the focus map cost the final pass 7-10 %.
+// do, and choosing the focus map cost the final pass 7-10 % when it looked the thickness up per pixel.
 float shadow_thickness(int i, vec3 x, float dist) {
     vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
     vec3 p = s.xyz / s.w;

@@ -40,6 +40,7 @@ use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::specular;
 use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
+use crate::skin::translucent::TranslucentPass;
 use crate::skin::{mean_stretch, SkinSettings};
 use ash::vk;
 use glam::Vec3;
@@ -238,6 +239,7 @@ struct Passes {
     direct: DirectPass,
     stretch: StretchMaps,
     irradiance: IrradiancePass,
+    translucent: TranslucentPass,
     blur: BlurChain,
     shade: ShadePass,
     shadow: ShadowPass,
@@ -273,6 +275,7 @@ impl Passes {
             irradiance: IrradiancePass::new(p, variant, res)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(p, variant, skin.transmission > 0.0, skin.blur_amount < 1.0)?,
+            translucent: TranslucentPass::new(p, variant, res, skin.transmission > 0.0)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res)?,
             prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
@@ -581,16 +584,23 @@ impl Frame {
         }
         let blurred = p.blur.chain(g, &irradiance, &stretch, &self.levels);
         let specular_env = p.prefilter.pass(g, &inputs.lighting_env);
+        // Per Gaussian its RGB weight and variance (mm²): the transmittance.
+        let profile = std::array::from_fn(|i| {
+            let variance = self
+                .skin
+                .profile
+                .gaussians
+                .get(i)
+                .map_or(0.0, |g| g.variance_mm2);
+            self.weights[i].extend(variance).into()
+        });
+        let key = self.lighting.shadow_key();
+        let translucent =
+            p.translucent
+                .pass(g, inputs, &self.tables, (&light.shadows, key), &profile);
         skybox::pass(g, &self.pipelines, inputs, hdr, self.post.skybox)?;
         let settings = ShadeSettings {
             weights: self.weights,
-            variances: std::array::from_fn(|i| {
-                self.skin
-                    .profile
-                    .gaussians
-                    .get(i)
-                    .map_or(0.0, |g| g.variance_mm2)
-            }),
             transmission: self.skin.transmission,
             mix: self.skin.mix,
             blur_amount: self.skin.blur_amount,
@@ -602,6 +612,7 @@ impl Frame {
             shadows: &light.shadows,
             soft_visibility: &light.soft,
             specular_env: &specular_env,
+            translucent: &translucent,
         };
         p.shade.pass(g, inputs, &self.tables, images, settings, hdr);
         Ok(())

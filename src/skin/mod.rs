@@ -11,6 +11,7 @@ pub mod shade;
 pub mod specular;
 pub mod stretch;
 pub mod tables;
+pub mod translucent;
 
 use crate::error::{Error, Result};
 use crate::frame::Vertex;

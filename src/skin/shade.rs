@@ -14,7 +14,7 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadePush {
-    /// rgb: the Gaussian's weights; w: its variance, mm² (the transmittance).
+    /// rgb: the Gaussian's weights (w: std430's padding of a vec3 array).
     weights: [[f32; 4]; 6],
     mix_pre: f32,
     mode: u32,
@@ -27,9 +27,6 @@ struct ShadePush {
 pub struct ShadeSettings {
     /// RGB weight of each Gaussian (the paper's Fig. 2).
     pub weights: [glam::Vec3; 6],
-    /// Each Gaussian's variance, mm² (blur width applied): the transmittance
-    /// T(d) = Σ wᵢ exp(−d²/2vᵢ) (skin::profile::Profile::transmittance).
-    pub variances: [f32; 6],
     /// Scale on the transmitted light (SkinSettings::transmission). The pass's
     /// pipeline has the term only when it was built with it ([`ShadePass::new`]).
     pub transmission: f32,
@@ -52,6 +49,9 @@ pub struct ShadeImages<'a> {
     pub soft_visibility: &'a [ImageHandle],
     /// The KS-prefiltered environment (light::prefilter).
     pub specular_env: &'a ImageHandle,
+    /// The light transmitted through thin skin, front and back
+    /// (skin::translucent).
+    pub translucent: &'a [ImageHandle; 2],
 }
 
 /// What the final pass writes.
@@ -159,7 +159,7 @@ impl ShadePass {
         inputs.mesh.draw(pre);
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
         // specular environment, irradiance, six blur levels, the specular
-        // bindings, the soft lights' visibility, the atlas's depths.
+        // bindings, the soft lights' visibility, the translucent textures.
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -177,13 +177,12 @@ impl ShadePass {
             pass = pass.sample(v, &s.linear);
         }
         let pass = pass
-            .sample(images.shadows, &s.nearest)
+            .sample(&images.translucent[0], &s.linear)
+            .sample(&images.translucent[1], &s.linear)
             .color(hdr, LoadOp::Load)
             .depth(&mut depth, LoadOp::Load)
             .constants(&ShadePush {
-                weights: std::array::from_fn(|i| {
-                    settings.weights[i].extend(settings.variances[i]).into()
-                }),
+                weights: std::array::from_fn(|i| settings.weights[i].extend(0.0).into()),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
                 blur_amount: settings.blur_amount,

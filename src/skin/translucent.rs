@@ -1,0 +1,120 @@
+//! The shadowed lights' light through thin skin (translucent shadow maps,
+//! d'Eon & Luebke §14.5.3; Jimenez et al. 2010; docs/skin.md, "Transmission"),
+//! in texture space, once per lighting: it depends on the lights, their shadow
+//! atlas, the mesh and its maps, not on the camera, so it is drawn by the
+//! render's first frame that needs it and kept by the atlas's key, as the soft
+//! lights' visibility is (light::visibility). Both sides of the surface
+//! (translucent.frag); the final pass reads the side it shades with one
+//! bilinear lookup instead of a shadow-map thickness and six exponentials per
+//! light and pixel (issue 24; docs/performance.md).
+
+use super::tables::SpecularTables;
+use super::UV_FORMAT;
+use crate::error::Result;
+use crate::frame::{FrameInputs, ShaderVariant, Vertex};
+use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
+use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
+use ash::vk;
+use std::sync::Arc;
+
+/// Largest side of the textures: the transmittance changes over millimetres
+/// and 1024² is ~0.6 mm per texel on the scan (as the stretch maps,
+/// skin::stretch::MAX_RESOLUTION).
+pub const MAX_RESOLUTION: u32 = 1024;
+/// The textures: the front side's (the mesh's normal) and the back's.
+const NAMES: [&str; 2] = ["translucent_front", "translucent_back"];
+
+pub struct TranslucentPass {
+    pipeline: Arc<Pipeline>,
+    /// The term is on (`skin.transmission` > 0) and some light has a shadow
+    /// map; else the textures are 1×1 and cleared, so the final pass always has
+    /// them to bind.
+    on: bool,
+    textures: [Arc<Image>; 2],
+}
+
+impl TranslucentPass {
+    /// The pass and its textures at min(`resolution`, [`MAX_RESOLUTION`])² for
+    /// an irradiance texture of `resolution`²; `on`: the scene transmits.
+    pub fn new(
+        pipelines: &Pipelines,
+        variant: &ShaderVariant,
+        resolution: u32,
+        on: bool,
+    ) -> Result<Self> {
+        let ctx = pipelines.ctx();
+        let on = on && variant.shadowed != 0;
+        let side = if on {
+            resolution.min(MAX_RESOLUTION)
+        } else {
+            1
+        };
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let desc = ImageDesc::new(side, side, UV_FORMAT);
+        let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
+        Ok(Self {
+            pipeline: pipelines.graphics(&GraphicsDesc {
+                vertex: "uv.vert",
+                fragment: "translucent.frag",
+                color_formats: &[UV_FORMAT; 2],
+                depth_format: None,
+                depth_write: true,
+                vertex_layout: Some(Vertex::layout()),
+                // UV charts may be mirrored: both windings are surface.
+                cull_mode: vk::CullModeFlags::NONE,
+                specialization: &variant.specialization(),
+                alpha_blend: false,
+            })?,
+            on,
+            textures: [image(NAMES[0])?, image(NAMES[1])?],
+        })
+    }
+
+    /// The front and back textures, from the lights' shadow `atlas`
+    /// (light::shadow), kept for `key` (the atlas's); `profile`: per Gaussian
+    /// its RGB weight and its variance (mm²).
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        inputs: &FrameInputs,
+        tables: &SpecularTables,
+        (atlas, key): (&ImageHandle, u64),
+        profile: &[[f32; 4]; 6],
+    ) -> [ImageHandle; 2] {
+        let mut draw = false;
+        let mut out: [ImageHandle; 2] = std::array::from_fn(|k| {
+            let (image, stale) = g.import_kept_image(
+                NAMES[k],
+                Imported::Image(self.textures[k].clone()),
+                Access::ShaderSampled,
+                key,
+            );
+            draw |= stale;
+            image
+        });
+        if !draw {
+            return out;
+        }
+        let s = &inputs.samplers;
+        let pass = g
+            .simple_pass("translucent", &self.pipeline)
+            .uniform(&inputs.uniforms)
+            .sample(atlas, &s.shadow)
+            .sample(atlas, &s.nearest)
+            .texture(&inputs.normal, &s.linear);
+        let [front, back] = &mut out;
+        let pass = tables
+            .bind(pass, inputs)
+            .color(front, LoadOp::Clear([0.0; 4]))
+            .color(back, LoadOp::Clear([0.0; 4]))
+            .constants(profile);
+        if self.on {
+            inputs.mesh.draw(pass);
+        } else {
+            pass.record(|_| {});
+        }
+        out
+    }
+}
