@@ -99,6 +99,23 @@ def parse_args(argv):
         help="map: dermis's spatial strength; dielectric: IOR 1.4 everywhere",
     )
     p.add_argument(
+        "--base",
+        choices=["map", "black", "black-to-camera"],
+        default="map",
+        help="black: base colour 0 and no subsurface, so the image is the specular "
+        "layer alone; black-to-camera: base colour 0 for camera rays only, so the "
+        "image is the specular layer alone, reflecting the skin as it is lit "
+        "(docs/skin.md, \"The specular against the reference's\")",
+    )
+    p.add_argument(
+        "--occlusion",
+        choices=["on", "off"],
+        default="on",
+        help="off: the head hides none of the sky from itself and reflects nothing "
+        "onto itself (invisible to shadow, diffuse and glossy rays; the camera still "
+        "sees it), as dermis's --occlusion off",
+    )
+    p.add_argument(
         "--bounces",
         type=int,
         default=8,
@@ -109,6 +126,12 @@ def parse_args(argv):
         metavar="R,G,B",
         help="instead of the head: a flat slab 1 m wide, 100 mm thick, of this "
         "linear albedo (no maps; specular at the map's mean), seen from above",
+    )
+    p.add_argument(
+        "--slab-mu",
+        type=float,
+        default=1.0,
+        help="with --slab: view the slab at this exit cosine (1: straight down)",
     )
     p.add_argument(
         "--skybox",
@@ -133,9 +156,10 @@ def parse_args(argv):
     )
     p.add_argument(
         "--view",
-        choices=["final", "albedo"],
+        choices=["final", "albedo", "rho-s"],
         default="final",
-        help="albedo: the albedo map as emission (to check the UVs)",
+        help="albedo: the albedo map as emission (to check the UVs); rho-s: dermis's "
+        "rho_s (the KS intensity the specular map gives, before the level) as emission",
     )
     p.add_argument(
         "--normal-pass",
@@ -182,6 +206,8 @@ def parse_args(argv):
             p.error("--slab takes three numbers R,G,B")
         if len(args.slab) != 3 or not all(0.0 <= c <= 1.0 for c in args.slab):
             p.error("--slab takes three numbers in [0, 1]")
+    if not 0.0 < args.slab_mu <= 1.0:
+        p.error("--slab-mu must be in (0, 1]")
     for name in ("width", "height", "samples", "threads"):
         if getattr(args, name) < 1:
             p.error(f"--{name} must be >= 1")
@@ -218,6 +244,26 @@ def image(name, colorspace):
     return img
 
 
+def rho_s_map(nodes, links):
+    """dermis's rho_s from the specular map (src/skin/specular.rs, map_rho_s):
+    0.18 (1 + (0.16/0.18) t), t = min(s / (2 s_mean), 1); the socket giving it."""
+    spec = nodes.new("ShaderNodeTexImage")
+    spec.image = image("Map-SPEC.jpg", "Non-Color")
+    red = nodes.new("ShaderNodeSeparateColor")
+    links.new(spec.outputs["Color"], red.inputs["Color"])
+    t = nodes.new("ShaderNodeMath")
+    t.operation = "MULTIPLY"
+    t.use_clamp = True
+    t.inputs[1].default_value = 1.0 / (2.0 * SPEC_MAP_MEAN)
+    links.new(red.outputs["Red"], t.inputs[0])
+    rho = nodes.new("ShaderNodeMath")
+    rho.operation = "MULTIPLY_ADD"
+    rho.inputs[1].default_value = KS_RHO_S * KS_MAP_GAIN
+    rho.inputs[2].default_value = KS_RHO_S
+    links.new(t.outputs["Value"], rho.inputs[0])
+    return rho.outputs["Value"]
+
+
 def skin_material(args):
     mat = bpy.data.materials.new("skin")
     mat.use_nodes = True
@@ -230,9 +276,12 @@ def skin_material(args):
     else:
         albedo = nodes.new("ShaderNodeTexImage")
         albedo.image = image("Map-COL.jpg", "sRGB")
-    if args.view == "albedo":
+    if args.view in ("albedo", "rho-s"):
         emit = nodes.new("ShaderNodeEmission")
-        links.new(albedo.outputs["Color"], emit.inputs["Color"])
+        if args.view == "albedo":
+            links.new(albedo.outputs["Color"], emit.inputs["Color"])
+        else:
+            links.new(rho_s_map(nodes, links), emit.inputs["Color"])
         links.new(emit.outputs["Emission"], out.inputs["Surface"])
         return mat
 
@@ -243,11 +292,28 @@ def skin_material(args):
     # diffuse mean free path) at the IOR, and refracts on entry; RANDOM_WALK
     # scales it by 1/(4 pi) and exits index-matched (docs/skin.md).
     bsdf.subsurface_method = "RANDOM_WALK_SKIN" if args.sss_method == "skin" else "RANDOM_WALK"
-    links.new(albedo.outputs["Color"], bsdf.inputs["Base Color"])
+    if args.base == "black":
+        # The specular layer alone: nothing under it reflects.
+        bsdf.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    elif args.base == "black-to-camera":
+        # Black where the camera looks, the albedo map for every other ray: the
+        # layer alone, with what it reflects of the skin.
+        path = nodes.new("ShaderNodeLightPath")
+        mix = nodes.new("ShaderNodeMix")
+        mix.data_type = "RGBA"
+        # The Mix node has a socket of each type per name; take the colour ones.
+        socket = {s.identifier: s for s in list(mix.inputs) + list(mix.outputs)}
+        links.new(path.outputs["Is Camera Ray"], socket["Factor_Float"])
+        links.new(albedo.outputs["Color"], socket["A_Color"])
+        socket["B_Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        links.new(socket["Result_Color"], bsdf.inputs["Base Color"])
+    else:
+        links.new(albedo.outputs["Color"], bsdf.inputs["Base Color"])
     bsdf.inputs["Metallic"].default_value = 0.0
     bsdf.inputs["Roughness"].default_value = math.sqrt(BECKMANN_M)
     bsdf.inputs["IOR"].default_value = SKIN_IOR
-    bsdf.inputs["Subsurface Weight"].default_value = 1.0 if args.sss == "on" else 0.0
+    sss_on = args.sss == "on" and args.base != "black"
+    bsdf.inputs["Subsurface Weight"].default_value = 1.0 if sss_on else 0.0
     bsdf.inputs["Subsurface Radius"].default_value = SKIN1_MFP_MM
     bsdf.inputs["Subsurface Scale"].default_value = 1.0 / MM_PER_UNIT
     bsdf.inputs["Subsurface Anisotropy"].default_value = 0.0
@@ -276,23 +342,11 @@ def skin_material(args):
     elif args.specular == "dielectric":
         level.default_value = 0.5
     else:
-        spec = nodes.new("ShaderNodeTexImage")
-        spec.image = image("Map-SPEC.jpg", "Non-Color")
-        red = nodes.new("ShaderNodeSeparateColor")
-        links.new(spec.outputs["Color"], red.inputs["Color"])
-        # t = min(s / (2 s_mean), 1)
-        t = nodes.new("ShaderNodeMath")
-        t.operation = "MULTIPLY"
-        t.use_clamp = True
-        t.inputs[1].default_value = 1.0 / (2.0 * SPEC_MAP_MEAN)
-        links.new(red.outputs["Red"], t.inputs[0])
-        # level = 0.5 rho_s / rho_s(dielectric) = a t + b
-        scale = 0.5 * KS_RHO_S / KS_RHO_S_DIELECTRIC
+        # level = 0.5 rho_s / rho_s(dielectric)
         lvl = nodes.new("ShaderNodeMath")
-        lvl.operation = "MULTIPLY_ADD"
-        lvl.inputs[1].default_value = scale * KS_MAP_GAIN
-        lvl.inputs[2].default_value = scale
-        links.new(t.outputs["Value"], lvl.inputs[0])
+        lvl.operation = "MULTIPLY"
+        lvl.inputs[1].default_value = 0.5 / KS_RHO_S_DIELECTRIC
+        links.new(rho_s_map(nodes, links), lvl.inputs[0])
         links.new(lvl.outputs["Value"], level)
     links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
     return mat
@@ -304,7 +358,7 @@ def world(args):
     nodes, links = w.node_tree.nodes, w.node_tree.links
     bg = nodes["Background"]
     bg.inputs["Strength"].default_value = 1.0
-    if args.view == "albedo":
+    if args.view != "final":
         bg.inputs["Color"].default_value = (0, 0, 0, 1)
     elif args.env == "uniform":
         bg.inputs["Color"].default_value = (args.sky, args.sky, args.sky, 1)
@@ -335,14 +389,14 @@ def slab():
     return box
 
 
-def slab_camera():
+def slab_camera(args):
     """Orthographic, 20 mm across the slab's centre, straight down."""
     data = bpy.data.cameras.new("camera")
     data.type = "ORTHO"
     data.ortho_scale = 20.0 / MM_PER_UNIT
     cam = bpy.data.objects.new("camera", data)
     bpy.context.scene.collection.objects.link(cam)
-    tilt_slab_camera(cam, 1.0)
+    tilt_slab_camera(cam, args.slab_mu)
     return cam
 
 
@@ -383,8 +437,13 @@ def main():
     head = slab() if args.slab else import_head()
     head.data.materials.clear()
     head.data.materials.append(skin_material(args))
+    if args.occlusion == "off":
+        head.visible_shadow = False
+        head.visible_diffuse = False
+        head.visible_glossy = False
+        head.visible_transmission = False
     scene.world = world(args)
-    scene.camera = slab_camera() if args.slab else camera(args)
+    scene.camera = slab_camera(args) if args.slab else camera(args)
     if args.sun:
         direction, irradiance = args.sun
         sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
