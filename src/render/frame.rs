@@ -544,12 +544,12 @@ impl Frame {
             // The frame was made with the checker as its albedo.
             Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr)?,
             Screen::Direct(view) => {
-                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.post.skybox)?;
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.post.skybox, None)?;
                 let (sh, shadows, soft) = (&light.sh, &light.shadows, &light.soft);
                 p.direct.pass(g, view, inputs, sh, shadows, soft, &mut hdr);
             }
             Screen::Debug(view) => {
-                skybox::pass(g, &self.pipelines, inputs, &mut hdr, false)?;
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, false, None)?;
                 p.debug.pass(g, view, inputs, self.depth_range, &mut hdr);
             }
             Screen::Reference => {
@@ -598,7 +598,16 @@ impl Frame {
         let translucent =
             p.translucent
                 .pass(g, inputs, &self.tables, (&light.shadows, key), &profile);
-        skybox::pass(g, &self.pipelines, inputs, hdr, self.post.skybox)?;
+        let size = (hdr.desc.width, hdr.desc.height);
+        let mut depth = p.shade.depth(g, inputs, &light.shadows, size);
+        skybox::pass(
+            g,
+            &self.pipelines,
+            inputs,
+            hdr,
+            self.post.skybox,
+            Some(&mut depth),
+        )?;
         let settings = ShadeSettings {
             weights: self.weights,
             transmission: self.skin.transmission,
@@ -614,7 +623,8 @@ impl Frame {
             specular_env: &specular_env,
             translucent: &translucent,
         };
-        p.shade.pass(g, inputs, &self.tables, images, settings, hdr);
+        p.shade
+            .pass(g, inputs, &self.tables, images, settings, hdr, &mut depth);
         Ok(())
     }
 

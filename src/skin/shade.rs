@@ -134,17 +134,15 @@ impl ShadePass {
         })
     }
 
-    /// Draws the mesh over `hdr` (which holds the background).
-    pub fn pass(
+    /// The depth pre-pass (`skin_depth`) at `(w, h)`: the mesh's depth, which
+    /// the background and the final pass test against.
+    pub fn depth(
         &self,
         g: &mut Graph,
         inputs: &FrameInputs,
-        tables: &SpecularTables,
-        images: ShadeImages,
-        settings: ShadeSettings,
-        hdr: &mut ImageHandle,
-    ) {
-        let (w, h) = (hdr.desc.width, hdr.desc.height);
+        shadows: &ImageHandle,
+        (w, h): (u32, u32),
+    ) -> ImageHandle {
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
         let s = &inputs.samplers;
         // mesh_lit.vert's bindings (frame 0, transfer 4) in skin.frag's order.
@@ -153,10 +151,27 @@ impl ShadePass {
             .uniform(&inputs.uniforms)
             .texture(&inputs.albedo, &s.linear)
             .texture(&inputs.normal, &s.linear)
-            .sample(images.shadows, &s.shadow)
+            .sample(shadows, &s.shadow)
             .buffer(&inputs.transfer)
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
+        depth
+    }
+
+    /// Draws the mesh over `hdr` (which holds the background) where `depth`
+    /// ([`ShadePass::depth`]) holds it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn pass(
+        &self,
+        g: &mut Graph,
+        inputs: &FrameInputs,
+        tables: &SpecularTables,
+        images: ShadeImages,
+        settings: ShadeSettings,
+        hdr: &mut ImageHandle,
+        depth: &mut ImageHandle,
+    ) {
+        let s = &inputs.samplers;
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
         // specular environment, irradiance, six blur levels, the specular
         // bindings, the soft lights' visibility, the translucent textures.
@@ -180,7 +195,7 @@ impl ShadePass {
             .sample(&images.translucent[0], &s.linear)
             .sample(&images.translucent[1], &s.linear)
             .color(hdr, LoadOp::Load)
-            .depth(&mut depth, LoadOp::Load)
+            .depth(depth, LoadOp::Load)
             .constants(&ShadePush {
                 weights: std::array::from_fn(|i| settings.weights[i].extend(0.0).into()),
                 mix_pre: settings.mix,
