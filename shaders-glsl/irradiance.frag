@@ -8,8 +8,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 #include "sh.glsl"
-layout(binding = 1) uniform sampler2D surface_normal_rho;
-layout(binding = 2) uniform sampler2D surface_albedo_m;
+layout(binding = 1) uniform sampler2D surface_normal_params;
+layout(binding = 2) uniform sampler2D surface_albedo_mix;
 // SH lighting from sh_reduce.comp: L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22
 // (rgb), rotated and scaled by the environment intensity.
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
@@ -29,6 +29,7 @@ layout(location = 7) in vec3 v_indirect;
 #define SPEC_INTENSITY 8
 #define SPEC_ROUGHNESS 9
 #include "ks_specular.glsl"
+#include "octahedral.glsl"
 #define SHADOW_ATLAS 10
 #define SOFT_VISIBILITY 11
 #include "lights.glsl"
@@ -38,8 +39,8 @@ layout(location = 0) out vec4 irradiance;
 
 void main() {
     ivec2 texel = ivec2(gl_FragCoord.xy);
-    vec4 n = texelFetch(surface_normal_rho, texel, 0);
-    vec4 a = texelFetch(surface_albedo_m, texel, 0);
-    vec3 e = irradiance_at(v_position, v_normal, normalize(n.xyz), v_uv, vec2(n.w, a.w));
-    irradiance = vec4(e * a.rgb, 1.0);
+    vec4 s = texelFetch(surface_normal_params, texel, 0);
+    vec3 n = octahedral_decode(s.xy * 2.0 - 1.0);
+    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, s.zw);
+    irradiance = vec4(e * texelFetch(surface_albedo_mix, texel, 0).rgb, 1.0);
 }

@@ -1,9 +1,10 @@
 #version 460
 // The irradiance pass's surface terms, which no light changes: drawn once per
 // render over the same UV raster as irradiance.frag, which reads them back
-// texel for texel (skin/irradiance.rs; issue 24). (n, ρs): the normal-mapped
-// shading normal and the specular's strength; (albedo^mix, m): the pre-scatter
-// albedo (GPU Gems 3 §14.5) and the lobe's roughness.
+// texel for texel (skin/irradiance.rs; issue 24). Two RGBA16 UNORM targets
+// (1.5·10⁻⁵ steps over [0, 1], finer than half floats there): the normal-mapped
+// shading normal, octahedral (common/octahedral.glsl), with the specular's (ρs,
+// m); and the pre-scatter albedo^mix (GPU Gems 3 §14.5).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
@@ -20,11 +21,13 @@ layout(location = 3) in vec4 v_tangent;
 #define SPEC_ROUGHNESS 7
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
-layout(location = 0) out vec4 normal_rho;
-layout(location = 1) out vec4 albedo_m;
+#include "octahedral.glsl"
+layout(location = 0) out vec4 normal_params;
+layout(location = 1) out vec4 albedo_mix;
 
 void main() {
     vec2 params = specular_params(v_uv);
-    normal_rho = vec4(map_normal(normal_tex, v_uv, v_normal, v_tangent), params.x);
-    albedo_m = vec4(pow(texture(albedo_tex, v_uv).rgb, vec3(pc.mix_pre)), params.y);
+    vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
+    normal_params = vec4(octahedral_encode(n) * 0.5 + 0.5, params);
+    albedo_mix = vec4(pow(texture(albedo_tex, v_uv).rgb, vec3(pc.mix_pre)), 1.0);
 }

@@ -42,7 +42,9 @@ pub fn texel_bytes(format: vk::Format) -> Option<u32> {
         | vk::Format::R8G8B8A8_SRGB
         | vk::Format::R32_SFLOAT
         | vk::Format::D32_SFLOAT => 4,
-        vk::Format::R16G16B16A16_SFLOAT | vk::Format::R32G32_SFLOAT => 8,
+        vk::Format::R16G16B16A16_SFLOAT
+        | vk::Format::R16G16B16A16_UNORM
+        | vk::Format::R32G32_SFLOAT => 8,
         vk::Format::R32G32B32A32_SFLOAT => 16,
         _ => return None,
     })
