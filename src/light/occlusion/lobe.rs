@@ -55,7 +55,8 @@ pub fn zonal(kappa: f32) -> [f32; 6] {
     let k = kappa.max(1e-3);
     let mut g = [0.0f32; 6];
     g[0] = 1.0;
-    g[1] = 1.0 / k.tanh() - 1.0 / k;
+    let e = (-2.0 * k).exp(); // coth κ = (1 + e^−2κ)/(1 − e^−2κ), finite at any κ
+    g[1] = (1.0 + e) / (1.0 - e) - 1.0 / k;
     for l in 1..5 {
         g[l + 1] = (g[l - 1] - (2 * l + 1) as f32 / k * g[l]).max(0.0);
     }
