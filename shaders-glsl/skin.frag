@@ -115,7 +115,10 @@ void main() {
     // the diffuse's cosine-weighted open sky (docs/skin.md).
     vec3 r = reflect(-v, n);
     float visibility = OCCLUSION ? lobe_visibility(v_s012, v_s345, v_s678, r, n, params.y) : 1.0;
-    spec += reflected * prefiltered_radiance(r, params.y) * visibility;
+    // The blocked share sees the head's own skin, not the sky: taken as lit
+    // like this point, its diffuse radiance (Jimenez et al. 2016's multi-bounce
+    // assumption: the occluders look like the point they occlude).
+    spec += reflected * mix(sss, prefiltered_radiance(r, params.y), visibility);
     if (pc.mode == 3u) {
         color = vec4(through * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit, 1.0);
         return;
