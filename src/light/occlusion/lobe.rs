@@ -325,12 +325,16 @@ mod tests {
         assert_eq!(t.coeffs[0], open());
     }
 
+    /// A vertex under test: position, unit normal, its baked coefficients, its
+    /// open-sky fraction (the old occlusion) and its visibility cone.
+    type Case = (Vec3, Vec3, [f32; 9], f32, (Vec3, f32));
+
     /// The baked SH + lobe against the KS lobe ray-cast (or integrated) at a
     /// set of vertices and views: (mean, p90) of |error| per view cosine, and
     /// the same for the open-sky fraction the shader used before.
     fn compare(
         label: &str,
-        cases: &[(Vec3, Vec3, [f32; 9], f32, (Vec3, f32))],
+        cases: &[Case],
         visible: &dyn Fn(usize, Vec3, Vec3) -> bool,
         mus: &[f32],
         m: f32,
