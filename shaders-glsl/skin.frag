@@ -19,7 +19,7 @@ layout(binding = 2) uniform sampler2D normal_tex;
 // The light transmitted through thin skin, front and back (skin/translucent.rs).
 layout(binding = 21) uniform sampler2D translucent_front;
 layout(binding = 22) uniform sampler2D translucent_back;
-// binding 4: the per-vertex transfer, read by mesh_lit.vert.
+// binding 4: the per-vertex transfer and lobe visibility, read by skin.vert.
 #define ENV_SPECULAR 5
 #include "env_specular.glsl"
 layout(binding = 6) uniform sampler2D irradiance;
@@ -36,7 +36,7 @@ layout(binding = 12) uniform sampler2D blur6;
 #define SPEC_ROUGHNESS 17
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
-#include "visibility.glsl"
+#include "lobe_visibility.glsl"
 // weights: rgb the Gaussians' weights (w: padding). mode: 0 final, 1 diffuse only, 2 specular only, 3 the
 // transmitted light only. blur_amount: the share of the blurred levels, the
 // rest the unblurred irradiance (the paper's menu). transmission: the scale on
@@ -61,6 +61,9 @@ layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_t012;
 layout(location = 5) in vec3 v_t345;
 layout(location = 6) in vec3 v_t678;
+layout(location = 7) in vec3 v_s012;
+layout(location = 8) in vec3 v_s345;
+layout(location = 9) in vec3 v_s678;
 layout(location = 0) out vec4 color;
 
 // A UV target at v_uv, normalised by its coverage.
@@ -107,10 +110,15 @@ void main() {
         vec3 e = light_irradiance(i, v_position, v_normal, n, v_uv, l);
         spec += e * ks_specular(n, l, v, light_lobe(i, params));
     }
-    // The environment's share, occluded like the diffuse by the vertex's
-    // visibility (1 without occlusion).
-    float visibility = OCCLUSION ? clamp(open_sky(v_t012.x), 0.0, 1.0) : 1.0;
-    spec += reflected * prefiltered_radiance(reflect(-v, n), params.y) * visibility;
+    // The environment's share, occluded by what lies in the lobe about the
+    // mirror direction (light/occlusion/lobe.rs; 1 without occlusion), not by
+    // the diffuse's cosine-weighted open sky (docs/skin.md).
+    vec3 r = reflect(-v, n);
+    float visibility = OCCLUSION ? lobe_visibility(v_s012, v_s345, v_s678, r, n, params.y) : 1.0;
+    // The blocked share sees the head's own skin, not the sky: taken as lit
+    // like this point, its diffuse radiance (Jimenez et al. 2016's multi-bounce
+    // assumption: the occluders look like the point they occlude).
+    spec += reflected * mix(sss, prefiltered_radiance(r, params.y), visibility);
     if (pc.mode == 3u) {
         color = vec4(through * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit, 1.0);
         return;

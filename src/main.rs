@@ -47,7 +47,7 @@ enum Command {
     /// Shares are fractions in --json. Runs on the CPU.
     #[command(after_help = AFTER_HELP)]
     Lights(inspect::LightsArgs),
-    /// Compute (and cache) the per-vertex occlusion, interreflected and transmitted transfers ahead of rendering.
+    /// Compute (and cache) the per-vertex occlusion transfer, the specular's lobe visibility, and the interreflected and transmitted transfers ahead of rendering.
     ///
     /// The scene's mesh (--mesh, --mm-per-unit) and `skin.occlusion`
     /// (--occlusion) are used.

@@ -862,6 +862,7 @@ fn precompute_fills_the_cache_and_reports_time() {
     assert!(
         stdout.contains("vertices")
             && stdout.contains(" s (")
+            && stdout.contains("specular occlusion (lobe visibility): ")
             && stdout.contains("interreflection: ")
             && stdout.contains("environment transmission: "),
         "{stdout}"
@@ -869,11 +870,11 @@ fn precompute_fills_the_cache_and_reports_time() {
     let files = || std::fs::read_dir(&cache).unwrap().count();
     assert_eq!(
         files(),
-        3,
-        "the occlusion, interreflected and transmitted transfers"
+        4,
+        "the occlusion transfer, the lobe visibility, the interreflected and transmitted transfers"
     );
     assert!(run().status.success(), "second run reads the cache");
-    assert_eq!(files(), 3, "and writes nothing new");
+    assert_eq!(files(), 4, "and writes nothing new");
     let out = dermis(&["precompute", "--occlusion", "sideways"]);
     assert_eq!(out.status.code(), Some(2));
 }

@@ -177,9 +177,9 @@ def main():
 
     print(
         "| region | pixels | ρs | μ | dermis | Cycles | ratio | unoccluded: dermis (ρs·A(μ)) / Cycles / ratio "
-        "| visibility: dermis / Cycles / ratio | Cycles reflecting the skin R / G / B | dermis / that |"
+        "| visibility: dermis / Cycles / ratio | Cycles reflecting the skin R / G / B | dermis / that | R / G / B |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in REGIONS:
         s = groups[name]
 
@@ -188,11 +188,13 @@ def main():
 
         dv, cv = f(d) / f(d_open), f(c) / f(c_open)
         skin = f(c_skin)
+        per = f(d4[..., :3]) / skin
         print(
             f"| {name} | {s.sum()} | {f(rho):.3f} | {f(mu):.2f} | {f(d):.4f} | {f(c):.4f} "
             f"| **{f(d) / f(c):.2f}** | {f(d_open):.4f} ({f(ks):.4f}) / {f(c_open):.4f} / {f(d_open) / f(c_open):.2f} "
             f"| {dv:.2f} / {cv:.2f} / **{dv / cv:.2f}** "
-            f"| {skin[0]:.4f} / {skin[1]:.4f} / {skin[2]:.4f} | {f(d) / skin.mean():.2f} |"
+            f"| {skin[0]:.4f} / {skin[1]:.4f} / {skin[2]:.4f} | {f(d) / skin.mean():.2f} "
+            f"| {per[0]:.2f} / {per[1]:.2f} / {per[2]:.2f} |"
         )
     if a.slabs:
         print()

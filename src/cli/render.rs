@@ -192,6 +192,12 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
         secs * 1e6 / t.coeffs.len().max(1) as f64,
         dermis::light::occlusion::default_cache_dir().display()
     );
+    let started = std::time::Instant::now();
+    dermis::light::occlusion::lobe_visibility_for(mesh, skin.occlusion);
+    println!(
+        "specular occlusion (lobe visibility): {:.2} s",
+        started.elapsed().as_secs_f64()
+    );
     if skin.interreflection {
         let started = std::time::Instant::now();
         dermis::light::interreflection::bounce_for(mesh, &scene.albedo, &t, skin.occlusion);

@@ -25,7 +25,9 @@ pub struct FrameInputs {
     pub mesh: Arc<MeshBuffers>,
     pub albedo: Arc<Image>,
     pub normal: Arc<Image>,
-    /// Per-vertex SH transfer, 9 floats per vertex (light::occlusion).
+    /// Per vertex the SH transfer (light::occlusion), then the SH of the
+    /// visibility the environment's specular reads through its lobe
+    /// (light::occlusion::lobe_visibility_for): 18 floats.
     pub transfer: Arc<Buffer>,
     /// Per vertex the interreflected transfer (light::interreflection) and the
     /// environment's transmitted one (light::transmission), each 9 floats per

@@ -107,6 +107,9 @@ mod tests {
         let m = v.merge(&f).unwrap();
         assert_eq!(m.bindings[4], Some(vk::DescriptorType::STORAGE_BUFFER));
         assert!(m.bindings.iter().all(Option::is_some), "{m:?}");
+        // skin.vert reads the same binding, for both of the skin pass's pipelines.
+        let v = ShaderLayout::of("skin.vert").unwrap();
+        assert_eq!(v.merge(&f).unwrap().bindings, m.bindings);
         assert!(ShaderLayout::of("no such shader").is_err());
     }
 }

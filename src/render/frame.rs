@@ -164,6 +164,14 @@ fn frame_inputs(
     let occlusion = scene.file.skin.occlusion;
     let transfer = crate::light::occlusion::transfer_for(ctx, &scene.mesh, occlusion)?;
     let n = scene.mesh.vertex_count();
+    let lobe = crate::light::occlusion::lobe_visibility_for(&scene.mesh, occlusion);
+    // Per vertex: the transfer, then the lobe visibility (common/transfer.glsl).
+    let per_vertex: Vec<[[f32; 9]; 2]> = transfer
+        .coeffs
+        .iter()
+        .zip(&lobe.coeffs)
+        .map(|(t, s)| [*t, *s])
+        .collect();
     let bounce = if scene.file.skin.interreflection {
         interreflection::bounce_for(&scene.mesh, albedo, &transfer, occlusion)
     } else {
@@ -195,8 +203,8 @@ fn frame_inputs(
         normal: upload_rgba8(ctx, "normal map", &scene.normal)?,
         transfer: upload_buffer(
             ctx,
-            "transfer",
-            bytemuck::cast_slice(&transfer.coeffs),
+            "transfer and lobe visibility",
+            bytemuck::cast_slice(&per_vertex),
             Access::ShaderBufferRead,
         )?,
         rgb_transfer: upload_buffer(

@@ -117,7 +117,7 @@ impl ShadePass {
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
             pipelines.graphics(&GraphicsDesc {
-                vertex: "mesh_lit.vert",
+                vertex: "skin.vert",
                 fragment,
                 color_formats,
                 depth_format: Some(DEPTH_FORMAT),
@@ -145,7 +145,7 @@ impl ShadePass {
     ) -> ImageHandle {
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
         let s = &inputs.samplers;
-        // mesh_lit.vert's bindings (frame 0, transfer 4) in skin.frag's order.
+        // skin.vert's bindings (frame 0, transfer 4) in skin.frag's order.
         let pre = g
             .simple_pass("skin_depth", &self.depth)
             .uniform(&inputs.uniforms)

@@ -14,12 +14,15 @@
 //! triangles (any-hit queries).
 //!
 //! # Files
-//! `transfer.rs` ([`Transfer`]), `raytrace.rs` (the CPU estimator), `bvh.rs`
+//! `transfer.rs` ([`Transfer`]), `raytrace.rs` (the CPU estimator), `lobe.rs`
+//! (the environment specular's occlusion: the visibility's SH, read through a
+//! lobe about the mirror direction), `bvh.rs`
 //! (the [`Bvh`] it queries), `raster.rs` (the GPU method), `cache.rs` (the disk
 //! cache, [`cache_key`]); [`transfer_for`] picks one, cache first.
 
 mod bvh;
 mod cache;
+mod lobe;
 pub mod raster;
 mod raytrace;
 #[cfg(test)]
@@ -28,6 +31,9 @@ mod transfer;
 
 pub use bvh::{Bvh, Hit};
 pub use cache::{cache_key, default_cache_dir, load_cached, rgb_cached, store_cached};
+pub use lobe::{
+    above, kappa, lobe_raytrace, lobe_visibility, lobe_visibility_for, open as open_lobe, zonal,
+};
 pub(crate) use raytrace::directions;
 pub use raytrace::{raytrace, RayOptions};
 pub use transfer::{unoccluded, RgbTransfer, Transfer};

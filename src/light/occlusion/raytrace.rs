@@ -99,9 +99,8 @@ fn vertex_shift(seed: u32, index: u32) -> (f32, f32) {
     (unit(h), unit(hash32(h ^ 0x68e3_1da4)))
 }
 
-/// Sample `k` of `n` of the rotated Hammersley set, mapped to a cosine-weighted
-/// direction in the local frame (z = normal).
-fn cosine_sample(k: u32, n: u32, shift: (f32, f32)) -> Vec3 {
+/// Point `k` of `n` of the Hammersley set rotated by `shift`, in [0, 1)².
+fn hammersley(k: u32, n: u32, shift: (f32, f32)) -> (f32, f32) {
     let wrap = |x: f32| {
         let f = x - x.floor();
         if f < 1.0 {
@@ -110,8 +109,16 @@ fn cosine_sample(k: u32, n: u32, shift: (f32, f32)) -> Vec3 {
             0.0
         }
     };
-    let u1 = wrap(k as f32 / n as f32 + shift.0);
-    let u2 = wrap(unit(k.reverse_bits()) + shift.1);
+    (
+        wrap(k as f32 / n as f32 + shift.0),
+        wrap(unit(k.reverse_bits()) + shift.1),
+    )
+}
+
+/// Sample `k` of `n` of the rotated Hammersley set, mapped to a cosine-weighted
+/// direction in the local frame (z = normal).
+fn cosine_sample(k: u32, n: u32, shift: (f32, f32)) -> Vec3 {
+    let (u1, u2) = hammersley(k, n, shift);
     let r = u1.sqrt();
     let (s, c) = (2.0 * PI * u2).sin_cos();
     Vec3::new(r * c, r * s, (1.0 - u1).max(0.0).sqrt())
@@ -127,15 +134,40 @@ pub(crate) fn directions(nrm: Vec3, n: u32, seed: u32, index: u32) -> impl Itera
     })
 }
 
-/// Transfer vector of one vertex (module doc's estimator).
-fn vertex_transfer(bvh: &Bvh, p: Vec3, nrm: Vec3, opts: &RayOptions, index: u32) -> [f32; 9] {
-    let n = opts.samples.max(1);
+/// Like [`directions`] but uniform over the hemisphere about `nrm`
+/// (`cos θ = 1 − u₁`, density 1/(2π)): for integrands without the cosine
+/// (light::occlusion::lobe), whose grazing directions matter as much.
+pub(crate) fn uniform_directions(
+    nrm: Vec3,
+    n: u32,
+    seed: u32,
+    index: u32,
+) -> impl Iterator<Item = Vec3> {
+    let (b1, b2) = nrm.any_orthonormal_pair();
+    let shift = vertex_shift(seed, index);
+    (0..n).map(move |k| {
+        let (u1, u2) = hammersley(k, n, shift);
+        let z = 1.0 - u1;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = (2.0 * PI * u2).sin_cos();
+        b1 * (r * c) + b2 * (r * s) + nrm * z
+    })
+}
+
+/// Ray origin of a vertex at `p` with unit normal `nrm`: lifted by the offset.
+pub(super) fn ray_origin(p: Vec3, nrm: Vec3, opts: &RayOptions) -> Vec3 {
     let offset = if opts.offset_mm.is_finite() {
         opts.offset_mm.max(0.0)
     } else {
         0.0
     };
-    let origin = p + nrm * offset;
+    p + nrm * offset
+}
+
+/// Transfer vector of one vertex (module doc's estimator).
+fn vertex_transfer(bvh: &Bvh, p: Vec3, nrm: Vec3, opts: &RayOptions, index: u32) -> [f32; 9] {
+    let n = opts.samples.max(1);
+    let origin = ray_origin(p, nrm, opts);
     let mut blocked = [0.0f64; 9];
     for w in directions(nrm, n, opts.seed, index) {
         if bvh.occluded(origin, w, f32::INFINITY) {
@@ -160,6 +192,26 @@ const CHUNK: usize = 32;
 /// terminal). Each vertex has its own seed: the result does not depend on the
 /// thread count.
 pub fn raytrace(mesh: &Mesh, opts: &RayOptions, progress: bool) -> Transfer {
+    per_vertex(
+        mesh,
+        opts,
+        progress,
+        "occlusion (ray trace)",
+        vertex_transfer,
+    )
+}
+
+/// `f(bvh, position, unit normal, opts, index)` for every vertex of `mesh` over
+/// rayon's threads, against one BVH of its triangles; `what` names the work in
+/// the progress bar and the log. Vertices with no finite position or normal
+/// get zeros.
+pub(super) fn per_vertex(
+    mesh: &Mesh,
+    opts: &RayOptions,
+    progress: bool,
+    what: &str,
+    f: impl Fn(&Bvh, Vec3, Vec3, &RayOptions, u32) -> [f32; 9] + Sync,
+) -> Transfer {
     let start = Instant::now();
     let bvh = Bvh::from_mesh(mesh);
     let t_bvh = start.elapsed();
@@ -172,7 +224,7 @@ pub fn raytrace(mesh: &Mesh, opts: &RayOptions, progress: bool) -> Transfer {
         ) {
             bar.set_style(style);
         }
-        bar.set_message("occlusion (ray trace)");
+        bar.set_message(what.to_string());
         bar
     } else {
         indicatif::ProgressBar::hidden()
@@ -188,7 +240,7 @@ pub fn raytrace(mesh: &Mesh, opts: &RayOptions, progress: bool) -> Transfer {
             for (j, t) in out.iter_mut().enumerate() {
                 let i = c * CHUNK + j;
                 *t = match vertex_frame(mesh, i) {
-                    Some((p, n)) => vertex_transfer(&bvh, p, n, opts, i as u32),
+                    Some((p, n)) => f(&bvh, p, n, opts, i as u32),
                     None => {
                         invalid.fetch_add(1, Ordering::Relaxed);
                         [0.0; 9]
@@ -200,13 +252,11 @@ pub fn raytrace(mesh: &Mesh, opts: &RayOptions, progress: bool) -> Transfer {
     bar.finish_and_clear();
     let invalid = invalid.into_inner();
     if invalid > 0 {
-        log::warn!(
-            "occlusion: {invalid} vertices have no finite position/normal; transfer set to 0"
-        );
+        log::warn!("{what}: {invalid} vertices have no finite position/normal; set to 0");
     }
     let secs = start.elapsed().as_secs_f64();
     log::info!(
-        "occlusion (ray trace): {count} vertices × {} rays, {} triangles, {threads} threads: \
+        "{what}: {count} vertices × {} rays, {} triangles, {threads} threads: \
          {secs:.2} s (BVH {:.0} ms, {:.1} µs/vertex)",
         opts.samples.max(1),
         bvh.triangle_count(),
