@@ -5,7 +5,9 @@
 //! reused while it stays the same.
 
 use super::{Access, BufferHandle, Graph, ImageHandle, Imported};
+use crate::gpu::Image;
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// The key each kept resource was last computed for, by name: what a graph's
 /// owner carries from one frame to the next (`Graph::with_kept`, `Plan::kept`).
@@ -36,6 +38,25 @@ impl Graph {
         let handle = self.import_image(name, image, valid.then_some(access), Some(access));
         let compute = self.keep(handle.id, key, valid);
         (handle, compute)
+    }
+
+    /// [`Graph::import_kept_image`] for images one pass computes together:
+    /// their handles, and whether any of them is to be computed (then the
+    /// pass writes them all).
+    pub fn import_kept_images<const N: usize>(
+        &mut self,
+        images: [(&str, &Arc<Image>); N],
+        access: Access,
+        key: u64,
+    ) -> ([ImageHandle; N], bool) {
+        let mut compute = false;
+        let handles = images.map(|(name, image)| {
+            let imported = Imported::Image(image.clone());
+            let (handle, stale) = self.import_kept_image(name, imported, access, key);
+            compute |= stale;
+            handle
+        });
+        (handles, compute)
     }
 
     /// [`Graph::import_kept_image`] for a buffer.

@@ -10,7 +10,7 @@
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
-use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
+use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -82,17 +82,9 @@ impl VisibilityPass {
         atlas: &ImageHandle,
         key: u64,
     ) -> [ImageHandle; TEXTURES] {
-        let mut draw = false;
-        let mut out: [ImageHandle; TEXTURES] = std::array::from_fn(|k| {
-            let (image, stale) = g.import_kept_image(
-                &name(k),
-                Imported::Image(self.textures[k].clone()),
-                Access::ShaderSampled,
-                key,
-            );
-            draw |= stale;
-            image
-        });
+        let names: [String; TEXTURES] = std::array::from_fn(name);
+        let images = std::array::from_fn(|k| (names[k].as_str(), &self.textures[k]));
+        let (mut out, draw) = g.import_kept_images(images, Access::ShaderSampled, key);
         if !draw {
             return out;
         }

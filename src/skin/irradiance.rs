@@ -10,9 +10,9 @@
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex};
-use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
-use crate::graph::{Access, BufferHandle, Graph, ImageHandle, Imported, LoadOp};
+use crate::frame::{FrameInputs, ShaderVariant};
+use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
+use crate::graph::{Access, BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -40,19 +40,18 @@ impl IrradiancePass {
         let desc = ImageDesc::new(resolution, resolution, SURFACE_FORMAT);
         let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
         Ok(Self {
-            pipeline: uv_pipeline(pipelines, "uv_lit.vert", "irradiance.frag", &specialization)?,
-            surface_pipeline: pipelines.graphics(&GraphicsDesc {
-                vertex: "uv.vert",
-                fragment: "surface.frag",
-                color_formats: &[SURFACE_FORMAT; 2],
-                depth_format: None,
-                depth_write: true,
-                vertex_layout: Some(Vertex::layout()),
-                // UV charts may be mirrored: both windings are surface.
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &specialization,
-                alpha_blend: false,
-            })?,
+            pipeline: uv_pipeline(
+                pipelines,
+                ("uv_lit.vert", "irradiance.frag"),
+                &[UV_FORMAT],
+                &specialization,
+            )?,
+            surface_pipeline: uv_pipeline(
+                pipelines,
+                ("uv.vert", "surface.frag"),
+                &[SURFACE_FORMAT; 2],
+                &specialization,
+            )?,
             surface: [image(SURFACE[0])?, image(SURFACE[1])?],
         })
     }
@@ -72,17 +71,9 @@ impl IrradiancePass {
         mix: f32,
     ) -> ImageHandle {
         let s = &inputs.samplers;
-        let mut draw = false;
-        let mut surface: [ImageHandle; 2] = std::array::from_fn(|k| {
-            let (image, stale) = g.import_kept_image(
-                SURFACE[k],
-                Imported::Image(self.surface[k].clone()),
-                Access::ShaderSampled,
-                0,
-            );
-            draw |= stale;
-            image
-        });
+        let [normal, albedo] = &self.surface;
+        let images = [(SURFACE[0], normal), (SURFACE[1], albedo)];
+        let (mut surface, draw) = g.import_kept_images(images, Access::ShaderSampled, 0);
         if draw {
             let pass = g
                 .simple_pass("surface", &self.surface_pipeline)

@@ -139,17 +139,18 @@ pub fn mean_stretch(mesh: &Mesh, resolution: u32) -> f32 {
     }
 }
 
-/// A pipeline that rasterises the mesh in UV space into one UV_FORMAT target.
+/// A pipeline that rasterises the mesh in UV space into targets of
+/// `color_formats`.
 pub(crate) fn uv_pipeline(
     pipelines: &Pipelines,
-    vertex: &str,
-    fragment: &str,
+    (vertex, fragment): (&str, &str),
+    color_formats: &[vk::Format],
     specialization: &[u32],
 ) -> Result<Arc<Pipeline>> {
     pipelines.graphics(&GraphicsDesc {
         vertex,
         fragment,
-        color_formats: &[UV_FORMAT],
+        color_formats,
         depth_format: None,
         depth_write: true,
         vertex_layout: Some(Vertex::layout()),

@@ -61,7 +61,7 @@ impl StretchMaps {
             })
             .collect::<Result<_>>()?;
         Ok(Self {
-            pipeline: uv_pipeline(pipelines, "uv.vert", "stretch.frag", &[])?,
+            pipeline: uv_pipeline(pipelines, ("uv.vert", "stretch.frag"), &[UV_FORMAT], &[])?,
             levels,
             constant,
             shear,

@@ -9,11 +9,11 @@
 //! light and pixel (issue 24; docs/performance.md).
 
 use super::tables::SpecularTables;
-use super::UV_FORMAT;
+use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex};
-use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
-use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
+use crate::frame::{FrameInputs, ShaderVariant};
+use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
+use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -55,18 +55,12 @@ impl TranslucentPass {
         let desc = ImageDesc::new(side, side, UV_FORMAT);
         let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
         Ok(Self {
-            pipeline: pipelines.graphics(&GraphicsDesc {
-                vertex: "uv.vert",
-                fragment: "translucent.frag",
-                color_formats: &[UV_FORMAT; 2],
-                depth_format: None,
-                depth_write: true,
-                vertex_layout: Some(Vertex::layout()),
-                // UV charts may be mirrored: both windings are surface.
-                cull_mode: vk::CullModeFlags::NONE,
-                specialization: &variant.specialization(),
-                alpha_blend: false,
-            })?,
+            pipeline: uv_pipeline(
+                pipelines,
+                ("uv.vert", "translucent.frag"),
+                &[UV_FORMAT; 2],
+                &variant.specialization(),
+            )?,
             on,
             textures: [image(NAMES[0])?, image(NAMES[1])?],
         })
@@ -83,17 +77,9 @@ impl TranslucentPass {
         (atlas, key): (&ImageHandle, u64),
         profile: &[[f32; 4]; 6],
     ) -> [ImageHandle; 2] {
-        let mut draw = false;
-        let mut out: [ImageHandle; 2] = std::array::from_fn(|k| {
-            let (image, stale) = g.import_kept_image(
-                NAMES[k],
-                Imported::Image(self.textures[k].clone()),
-                Access::ShaderSampled,
-                key,
-            );
-            draw |= stale;
-            image
-        });
+        let [front, back] = &self.textures;
+        let images = [(NAMES[0], front), (NAMES[1], back)];
+        let (mut out, draw) = g.import_kept_images(images, Access::ShaderSampled, key);
         if !draw {
             return out;
         }

@@ -86,14 +86,19 @@ pub fn open() -> [f32; 9] {
 /// `m`: 1 − (the lobe's blocked share)/(its share above the horizon), in [0, 1].
 pub fn lobe_visibility(v: &[f32; 9], r: Vec3, n: Vec3, m: f32) -> f32 {
     let g = zonal(kappa(m));
+    (1.0 - (1.0 - whole_lobe(v, r, &g)) / above(&g, n.dot(r))).clamp(0.0, 1.0)
+}
+
+/// The visibility `v` convolved with the lobe of Legendre coefficients `g`,
+/// read at `r`: the lobe's open share over the whole sphere.
+fn whole_lobe(v: &[f32; 9], r: Vec3, g: &[f32]) -> f32 {
     let band = [0, 1, 1, 1, 2, 2, 2, 2, 2];
-    let whole: f32 = sh::basis(r)
+    sh::basis(r)
         .iter()
         .zip(v)
         .zip(band)
         .map(|((y, c), l)| g[l] * c * y)
-        .sum();
-    (1.0 - (1.0 - whole) / above(&g, n.dot(r))).clamp(0.0, 1.0)
+        .sum()
 }
 
 /// Baked coefficients of one vertex (module doc's estimator).
@@ -154,7 +159,7 @@ pub fn lobe_visibility_for(mesh: &Mesh, mode: Occlusion) -> Transfer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::occlusion::testutil::{ground, mesh, quad};
+    use crate::light::occlusion::testutil::{floor_beside_a_wall, ground, mesh};
 
     /// d'Eon's KS lobe toward `l` seen from `v` about `n` (the shader's
     /// `ks_specular` with ρs = 1): N·L·PH(N·H)·F(H·V)/|L+V|², PH = π·D
@@ -420,15 +425,7 @@ mod tests {
     /// [`lobe_visibility`] without the division by the lobe's share above the
     /// horizon (for the comparison).
     fn lobe_visibility_flat(v: &[f32; 9], r: Vec3, m: f32) -> f32 {
-        let g = zonal(kappa(m));
-        let band = [0, 1, 1, 1, 2, 2, 2, 2, 2];
-        let whole: f32 = sh::basis(r)
-            .iter()
-            .zip(v)
-            .zip(band)
-            .map(|((y, c), l)| g[l] * c * y)
-            .sum();
-        whole.clamp(0.0, 1.0)
+        whole_lobe(v, r, &zonal(kappa(m))).clamp(0.0, 1.0)
     }
 
     #[test]
@@ -436,16 +433,7 @@ mod tests {
         // Floor y = 0, vertex 0 at the origin (normal +Y); a 1000 mm wall at
         // x = 0.5 mm blocks ω.x > 0. The truth integrates the KS lobe over
         // {ω.x ≤ 0} exactly (no rays); the bake casts its 256 rays.
-        let (mut p, mut n, mut idx) = ground(1000.0);
-        let (x, h) = (0.5, 1000.0);
-        let corners = [
-            Vec3::new(x, 0.0, -h),
-            Vec3::new(x, h, -h),
-            Vec3::new(x, h, h),
-            Vec3::new(x, 0.0, h),
-        ];
-        quad(&mut p, &mut n, &mut idx, corners, Vec3::NEG_X);
-        let m_ = mesh(p, n, idx);
+        let m_ = floor_beside_a_wall();
         let mut cases = Vec::new();
         for seed in 0..8 {
             let o = RayOptions {

@@ -269,7 +269,7 @@ pub(super) fn per_vertex(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::occlusion::testutil::{cylinder, ground, mesh, quad};
+    use crate::light::occlusion::testutil::{cylinder, floor_beside_a_wall, ground, mesh};
     use crate::light::occlusion::unoccluded;
     use std::f64::consts::PI as PI64;
 
@@ -391,16 +391,7 @@ mod tests {
         // Ground with vertex 0 at the origin; a 1000 mm wall at x = 0.5 mm
         // blocks ω.x > 0 (it misses only directions within ~1e-3 rad of the
         // wall's top/side edges as seen from the vertex).
-        let (mut p, mut n, mut idx) = ground(1000.0);
-        let (x, h) = (0.5, 1000.0);
-        let corners = [
-            Vec3::new(x, 0.0, -h),
-            Vec3::new(x, h, -h),
-            Vec3::new(x, h, h),
-            Vec3::new(x, 0.0, h),
-        ];
-        quad(&mut p, &mut n, &mut idx, corners, Vec3::NEG_X);
-        let m = mesh(p, n, idx);
+        let m = floor_beside_a_wall();
         for samples in [64, 256, 1024] {
             let mut worst = 0.0f64;
             for seed in 0..8 {

@@ -112,3 +112,19 @@ pub(crate) fn open_sphere(r: f32, alpha: f32, rings: u32, segments: u32) -> Mesh
     }
     mesh(p, n, idx)
 }
+
+/// [`ground`] of half-size 1000 mm with vertex 0 at the origin, and a 1000 mm
+/// wall at x = 0.5 mm facing it (−X): it blocks ω.x > 0 as seen from vertex 0
+/// (but for directions within ~1e-3 rad of its top and side edges).
+pub(super) fn floor_beside_a_wall() -> Mesh {
+    let (mut p, mut n, mut idx) = ground(1000.0);
+    let (x, h) = (0.5, 1000.0);
+    let corners = [
+        Vec3::new(x, 0.0, -h),
+        Vec3::new(x, h, -h),
+        Vec3::new(x, h, h),
+        Vec3::new(x, 0.0, h),
+    ];
+    quad(&mut p, &mut n, &mut idx, corners, Vec3::NEG_X);
+    mesh(p, n, idx)
+}
