@@ -32,6 +32,9 @@ layout(location = 7) in vec3 v_indirect;
 #include "octahedral.glsl"
 #define SHADOW_ATLAS 10
 #define SOFT_VISIBILITY 11
+// Bindings 15..17 (after the per-vertex colour's 14): the other shadowed
+// lights' visibility, drawn over this raster (light/visibility.rs).
+#define HARD_VISIBILITY 15
 #include "lights.glsl"
 #define ENERGY_CONSERVING
 #include "lighting.glsl"

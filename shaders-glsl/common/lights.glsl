@@ -221,12 +221,26 @@ float stored_soft_visibility(int i, vec2 uv) {
 }
 #endif
 
-// Fraction of light i that reaches x (surface normal ng, texture coordinate uv)
-// from direction l.
-float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
-#ifdef SOFT_VISIBILITY
-    if ((SOFT_LIGHTS & (1 << i)) != 0) return stored_soft_visibility(i, uv);
+#ifdef HARD_VISIBILITY
+layout(binding = HARD_VISIBILITY) uniform sampler2D hard_visibility0;
+layout(binding = HARD_VISIBILITY + 1) uniform sampler2D hard_visibility1;
+layout(binding = HARD_VISIBILITY + 2) uniform sampler2D hard_visibility2;
+
+// Hard light i's visibility at this fragment, as light_visibility.frag (HARD)
+// stored it over the same UV raster at the same resolution: texel for texel.
+float stored_hard_visibility(int i) {
+    int slot = bitCount(SHADOWED_LIGHTS & ~SOFT_LIGHTS & ((1 << i) - 1));
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 t = slot < 3 ? texelFetch(hard_visibility0, p, 0)
+           : slot < 6 ? texelFetch(hard_visibility1, p, 0)
+                      : texelFetch(hard_visibility2, p, 0);
+    return t[slot % 3];
+}
 #endif
+
+// Fraction of light i (without an angular size) that reaches x (surface normal
+// ng) from direction l: 3×3 bilinear PCF.
+float hard_shadow(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     ShadowMap m = shadow_map(i, x, 0.0);
     vec3 s = shadow_point(m, frame.light_vec[i].w > 0.5, x, ng, l, dist).xyz;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
@@ -238,6 +252,18 @@ float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
         }
     }
     return lit / 9.0;
+}
+
+// Fraction of light i that reaches x (surface normal ng, texture coordinate uv)
+// from direction l.
+float shadow_visibility(int i, vec3 x, vec3 ng, vec2 uv, vec3 l, float dist) {
+#ifdef SOFT_VISIBILITY
+    if ((SOFT_LIGHTS & (1 << i)) != 0) return stored_soft_visibility(i, uv);
+#endif
+#ifdef HARD_VISIBILITY
+    if ((SOFT_LIGHTS & (1 << i)) == 0) return stored_hard_visibility(i);
+#endif
+    return hard_shadow(i, x, ng, l, dist);
 }
 
 // Irradiance light i delivers at x (texture coordinate uv) to a surface facing

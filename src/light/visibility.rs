@@ -5,7 +5,10 @@
 //! UV layout (shaders-glsl/light_visibility.frag). The shading passes (irradiance,
 //! final skin, direct view) read it back with one bilinear fetch per three lights,
 //! so the soft shadows' taps are paid at half the irradiance resolution, at most
-//! [`MAX_RESOLUTION`]², whatever the screen.
+//! [`MAX_RESOLUTION`]², whatever the screen. The other shadowed lights' 3×3 PCF
+//! is drawn the same way at the irradiance resolution (`hard_visibility`), for
+//! the irradiance pass alone, which reads it texel for texel: the same values,
+//! in 8-bit steps, once per lighting instead of every frame (issue 24).
 
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex};
@@ -27,19 +30,32 @@ pub const TEXTURES: usize = 3;
 
 pub struct VisibilityPass {
     pipeline: Arc<Pipeline>,
-    /// Any light has an angular size and a shadow map.
-    soft: bool,
+    /// The soft lights' (light_visibility.frag) or, `hard`, the other shadowed
+    /// lights'.
+    hard: bool,
+    /// Some light of the kind has a shadow map.
+    any: bool,
     /// Drawn by the render's first frame that needs them and kept, as the
     /// shadow atlas they come from.
     textures: Vec<Arc<Image>>,
 }
 
 impl VisibilityPass {
-    /// The pass and its textures at min(`resolution`/2, [`MAX_RESOLUTION`])² for
-    /// an irradiance texture of `resolution`²; 1×1 when no light is soft, so the
-    /// shading passes always have them to bind.
-    pub fn new(pipelines: &Pipelines, variant: &ShaderVariant, resolution: u32) -> Result<Self> {
+    /// The soft lights' pass and its textures at min(`resolution`/2,
+    /// [`MAX_RESOLUTION`])² for an irradiance texture of `resolution`²; or
+    /// (`hard`) the other shadowed lights' at `resolution`², which only the
+    /// irradiance pass reads, texel for texel (the shading passes in screen
+    /// space filter those lights per pixel). 1×1 when no light is of the kind,
+    /// so the shading passes always have them to bind.
+    pub fn new(
+        pipelines: &Pipelines,
+        variant: &ShaderVariant,
+        resolution: u32,
+        hard: bool,
+    ) -> Result<Self> {
         let ctx = pipelines.ctx();
+        let mut specialization = variant.specialization().to_vec();
+        specialization.push(u32::from(hard));
         let pipeline = pipelines.graphics(&GraphicsDesc {
             vertex: "uv.vert",
             fragment: "light_visibility.frag",
@@ -49,25 +65,31 @@ impl VisibilityPass {
             vertex_layout: Some(Vertex::layout()),
             // UV charts may be mirrored: both windings are surface.
             cull_mode: vk::CullModeFlags::NONE,
-            specialization: &variant.specialization(),
+            specialization: &specialization,
             alpha_blend: false,
         })?;
-        let soft = variant.soft != 0;
-        let side = if soft {
-            (resolution / 2).clamp(1, MAX_RESOLUTION)
+        let lights = if hard {
+            variant.shadowed & !variant.soft
         } else {
-            1
+            variant.soft
+        };
+        // One pass draws all three: they share its render area.
+        let side = match (lights != 0, hard) {
+            (false, _) => 1,
+            (true, true) => resolution,
+            (true, false) => (resolution / 2).clamp(1, MAX_RESOLUTION),
         };
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
         let textures = (0..TEXTURES)
             .map(|k| {
                 let desc = ImageDesc::new(side, side, FORMAT);
-                Image::new(ctx, &name(k), desc, usage).map(Arc::new)
+                Image::new(ctx, &name(hard, k), desc, usage).map(Arc::new)
             })
             .collect::<Result<_>>()?;
         Ok(Self {
             pipeline,
-            soft,
+            hard,
+            any: lights != 0,
             textures,
         })
     }
@@ -82,15 +104,20 @@ impl VisibilityPass {
         atlas: &ImageHandle,
         key: u64,
     ) -> [ImageHandle; TEXTURES] {
-        let names: [String; TEXTURES] = std::array::from_fn(name);
+        let names: [String; TEXTURES] = std::array::from_fn(|k| name(self.hard, k));
         let images = std::array::from_fn(|k| (names[k].as_str(), &self.textures[k]));
         let (mut out, draw) = g.import_kept_images(images, Access::ShaderSampled, key);
         if !draw {
             return out;
         }
         let s = &inputs.samplers;
+        let pass_name = if self.hard {
+            "hard_visibility"
+        } else {
+            "light_visibility"
+        };
         let mut pass = g
-            .simple_pass("light_visibility", &self.pipeline)
+            .simple_pass(pass_name, &self.pipeline)
             .tag(super::TAG)
             .uniform(&inputs.uniforms)
             .sample(atlas, &s.shadow)
@@ -98,7 +125,7 @@ impl VisibilityPass {
         for image in &mut out {
             pass = pass.color(image, LoadOp::Clear([0.0; 4]));
         }
-        if self.soft {
+        if self.any {
             inputs.mesh.draw(pass);
         } else {
             pass.record(|_| {});
@@ -107,6 +134,7 @@ impl VisibilityPass {
     }
 }
 
-fn name(k: usize) -> String {
-    format!("soft visibility {k}")
+fn name(hard: bool, k: usize) -> String {
+    let kind = if hard { "hard" } else { "soft" };
+    format!("{kind} visibility {k}")
 }

@@ -252,6 +252,7 @@ struct Passes {
     shade: ShadePass,
     shadow: ShadowPass,
     visibility: VisibilityPass,
+    hard_visibility: VisibilityPass,
     prefilter: PrefilterPass,
     debug: DebugPass,
     meter: Meter,
@@ -285,7 +286,8 @@ impl Passes {
             shade: ShadePass::new(p, variant, skin.transmission > 0.0, skin.blur_amount < 1.0)?,
             translucent: TranslucentPass::new(p, variant, res, skin.transmission > 0.0)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
-            visibility: VisibilityPass::new(p, variant, res)?,
+            visibility: VisibilityPass::new(p, variant, res, false)?,
+            hard_visibility: VisibilityPass::new(p, variant, res, true)?,
             prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
             debug: DebugPass::new(p, &scene.regions)?,
             meter: Meter::new(p, s.nearest.clone())?,
@@ -325,6 +327,9 @@ struct LightImages {
     sh: BufferHandle,
     shadows: ImageHandle,
     soft: [ImageHandle; TEXTURES],
+    /// The other shadowed lights' visibility at the irradiance resolution,
+    /// for the irradiance pass.
+    hard: [ImageHandle; TEXTURES],
 }
 
 impl Frame {
@@ -526,15 +531,21 @@ impl Frame {
         Ok(screens.chain(images).collect())
     }
 
-    /// The SH coefficients, the shadow atlas and the soft lights' visibility,
-    /// each kept by the key of its inputs.
+    /// The SH coefficients, the shadow atlas and the lights' visibility in
+    /// texture space, each kept by the key of its inputs.
     fn lighting_images(&self, g: &mut Graph) -> LightImages {
         let p = &self.passes;
         let sh = p.sh.passes(g, &self.inputs.lighting_env, &self.sh_buffers);
         let key = self.lighting.shadow_key();
         let shadows = p.shadow.pass(g, &self.inputs.mesh, key);
         let soft = p.visibility.pass(g, &self.inputs, &shadows, key);
-        LightImages { sh, shadows, soft }
+        let hard = p.hard_visibility.pass(g, &self.inputs, &shadows, key);
+        LightImages {
+            sh,
+            shadows,
+            soft,
+            hard,
+        }
     }
 
     /// The screen image (HDR) of `screen` at `(w, h)`.
@@ -584,7 +595,7 @@ impl Frame {
             inputs,
             &self.tables,
             &light.sh,
-            (&light.shadows, &light.soft),
+            (&light.shadows, &light.soft, &light.hard),
             self.skin.mix,
         );
         if self.ruler {

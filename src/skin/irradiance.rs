@@ -57,9 +57,10 @@ impl IrradiancePass {
     }
 
     /// `sh`: the environment's coefficients (light::sh_pass); `shadows`: the
-    /// lights' shadow atlas (light::shadow) and `soft`, the soft lights'
-    /// visibility (light::visibility); `tables`: the specular term's, for energy
-    /// conservation on entry and the region parameters.
+    /// lights' shadow atlas (light::shadow), `soft` and `hard` the soft and the
+    /// other shadowed lights' visibility (light::visibility); `tables`: the
+    /// specular term's, for energy conservation on entry and the region
+    /// parameters.
     #[allow(clippy::too_many_arguments)]
     pub fn pass(
         &self,
@@ -67,7 +68,7 @@ impl IrradiancePass {
         inputs: &FrameInputs,
         tables: &SpecularTables,
         sh: &BufferHandle,
-        (shadows, soft): (&ImageHandle, &[ImageHandle]),
+        (shadows, soft, hard): (&ImageHandle, &[ImageHandle], &[ImageHandle]),
         mix: f32,
     ) -> ImageHandle {
         let s = &inputs.samplers;
@@ -101,9 +102,11 @@ impl IrradiancePass {
         for v in soft {
             pass = pass.sample(v, &s.linear);
         }
-        let pass = pass
-            .buffer(&inputs.rgb_transfer)
-            .color(&mut out, LoadOp::Clear([0.0; 4]));
+        let mut pass = pass.buffer(&inputs.rgb_transfer);
+        for v in hard {
+            pass = pass.sample(v, &s.nearest);
+        }
+        let pass = pass.color(&mut out, LoadOp::Clear([0.0; 4]));
         inputs.mesh.draw(pass);
         out
     }
