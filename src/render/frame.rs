@@ -330,6 +330,8 @@ struct LightImages {
     /// The other shadowed lights' visibility at the irradiance resolution,
     /// for the irradiance pass.
     hard: [ImageHandle; TEXTURES],
+    /// The key the lights' kept images are drawn for (Lighting::shadow_key).
+    key: u64,
 }
 
 impl Frame {
@@ -545,6 +547,7 @@ impl Frame {
             shadows,
             soft,
             hard,
+            key,
         }
     }
 
@@ -613,10 +616,13 @@ impl Frame {
                 .map_or(0.0, |g| g.variance_mm2);
             self.weights[i].extend(variance).into()
         });
-        let key = self.lighting.shadow_key();
-        let translucent =
-            p.translucent
-                .pass(g, inputs, &self.tables, (&light.shadows, key), &profile);
+        let translucent = p.translucent.pass(
+            g,
+            inputs,
+            &self.tables,
+            (&light.shadows, light.key),
+            &profile,
+        );
         let size = (hdr.desc.width, hdr.desc.height);
         let mut depth = p.shade.depth(g, inputs, &light.shadows, size);
         skybox::pass(
