@@ -1079,3 +1079,57 @@ fn reference_diffusion_refuses_bad_input() {
         );
     }
 }
+
+/// The pre-roll: frames rendered after the first for --warmup-ms and left out of
+/// the report; none by default on a CPU device (lavapipe).
+#[test]
+fn render_preroll_frames_are_rendered_but_not_reported() {
+    let frames_of = |extra: &[&str]| {
+        let json = tmp(&format!("preroll{}.json", extra.len()));
+        let png = tmp(&format!("preroll{}.png", extra.len()));
+        let mut args = vec![
+            "render",
+            "--out",
+            png.to_str().unwrap(),
+            "--irradiance-res",
+            "256",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            "3",
+            "--report",
+            json.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = dermis(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_no_validation_messages(&out);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(report["frames"], 3);
+        let numbers: Vec<u64> = report["per_frame"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["frame"].as_u64().unwrap())
+            .collect();
+        (report["preroll_ms"].as_u64().unwrap(), numbers)
+    };
+    assert_eq!(
+        frames_of(&[]),
+        (0, vec![0, 1, 2]),
+        "no pre-roll on lavapipe"
+    );
+    let (ms, numbers) = frames_of(&["--warmup-ms", "300"]);
+    assert_eq!(ms, 300);
+    assert_eq!(numbers.len(), 3);
+    assert_eq!(numbers[0], 0, "the first frame is reported");
+    assert!(numbers[1] > 1, "pre-roll frames come between: {numbers:?}");
+    assert_eq!(numbers[2], numbers[1] + 1);
+}

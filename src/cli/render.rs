@@ -43,6 +43,11 @@ pub struct RenderArgs {
     /// --frames is more than 1, else 0).
     #[arg(long)]
     warmup: Option<u32>,
+    /// Pre-roll: after each run's first frame, render unreported frames for this
+    /// many milliseconds, so that a GPU's clocks are up before the measured
+    /// frames (default: 1000 on GPUs, 0 on CPU devices such as lavapipe).
+    #[arg(long, value_name = "MS")]
+    warmup_ms: Option<u32>,
     /// Independent repetitions, each with a fresh upload, pipelines and
     /// warm-up, so that `dermis compare` has runs, not only frames of one
     /// pipeline state; the image is the last run's.
@@ -104,6 +109,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         ruler: args.ruler,
         runs: args.runs,
         warmup: args.warmup,
+        warmup_ms: args.warmup_ms,
     };
     opts.warmup_frames()?;
     let loaded = Scene::load(args.overrides.apply(file)?)?;

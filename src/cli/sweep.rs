@@ -44,6 +44,11 @@ pub struct SweepArgs {
     /// Frames per point (≥ 2; the first is warm-up, the rest give medians).
     #[arg(long, default_value_t = 4)]
     frames: u32,
+    /// Pre-roll per point: after its first frame, unreported frames for this
+    /// many milliseconds, so that a GPU's clocks are up (default: 1000 on GPUs,
+    /// 0 on CPU devices such as lavapipe).
+    #[arg(long, value_name = "MS")]
+    warmup_ms: Option<u32>,
     /// Irradiance resolution of the reference (accurate kernel, full chain).
     #[arg(long, default_value_t = 4096)]
     reference_resolution: u32,
@@ -141,6 +146,7 @@ pub fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
         kernels: args.kernels,
         chains: args.chains,
         frames: args.frames,
+        warmup_ms: args.warmup_ms,
         reference_resolution: args.reference_resolution,
     };
     sw::validate(&opts)?;

@@ -332,6 +332,11 @@ impl Executor {
         })
     }
 
+    /// Frames submitted so far: the number the next one's report will carry.
+    pub fn frames_submitted(&self) -> u64 {
+        self.frame
+    }
+
     /// Waits for every frame in flight; returns their reports in submission order.
     pub fn finish(&mut self) -> Result<Vec<FrameReport>> {
         let mut reports = Vec::new();

@@ -200,6 +200,11 @@ pub struct RunReport {
     pub frames: usize,
     /// Warm-up frames at the start of each run, outside the statistics.
     pub warmup_frames: usize,
+    /// The pre-roll after each run's first frame: frames rendered for this
+    /// long and not reported (render::RenderOptions::warmup_ms); 0 in reports
+    /// written before it existed.
+    #[serde(default)]
+    pub preroll_ms: u64,
     /// Same as `memory.transient_pool_bytes` (kept for older readers).
     pub transient_bytes: u64,
     pub memory: MemoryUse,
@@ -295,6 +300,7 @@ impl RunReport {
             runs: runs.len().max(1),
             frames: per_frame.len(),
             warmup_frames: warmup,
+            preroll_ms: 0,
             transient_bytes: memory.transient_pool_bytes,
             memory,
             passes,
@@ -328,7 +334,7 @@ impl RunReport {
             "{} ({}), API {}, CPU {} × {}, LP_NUM_THREADS={}, validation {}, dermis {} ({}{})\n\
              {} {}x{} (render {}x{}), irradiance {}², kernel {}, chain {}, occlusion {}, \
              mesh {}, env {} @ {}° ({} light(s) extracted, lights = {}), {} run(s), \
-             {} frame(s), {} warm-up per run\n\
+             {} frame(s), {} warm-up per run{}\n\
              exposure {:+.2} EV ({}), tone curve {}, glow {}, blur width {}, blur amount {}{}\n",
             f.device,
             f.driver,
@@ -357,6 +363,10 @@ impl RunReport {
             self.runs,
             self.frames,
             self.warmup_frames,
+            match self.preroll_ms {
+                0 => String::new(),
+                ms => format!(" (a {ms} ms pre-roll after the first)"),
+            },
             s.exposure_ev,
             if s.exposure_metered {
                 "metered"

@@ -31,6 +31,7 @@ use progress::Progress;
 use sheet::Sheet;
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::time::Instant;
 
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -52,7 +53,17 @@ pub struct RenderOptions {
     /// Warm-up frames per run, outside the statistics (`None`: 1 when there
     /// are more frames than one, else 0).
     pub warmup: Option<u32>,
+    /// Pre-roll: after a run's first frame, frames rendered and not reported
+    /// until this many milliseconds have passed, so that a GPU's clocks are up
+    /// before the frames that count (`None`: [`PREROLL_GPU_MS`] on GPUs, 0 on
+    /// CPU devices). Only when some frame is measured.
+    pub warmup_ms: Option<u32>,
 }
+
+/// The default pre-roll on GPUs. An NVIDIA H200 left idle between a sweep's
+/// points measured the next point at 345–750 MHz instead of 1980: its raster
+/// passes up to 5.6× slower (docs/performance.md, "On a real GPU").
+pub const PREROLL_GPU_MS: u32 = 1000;
 
 impl RenderOptions {
     /// Warm-up frames per run; an error when no measured frame would be left.
@@ -65,6 +76,17 @@ impl RenderOptions {
                 self.frames
             ))),
         }
+    }
+
+    /// The pre-roll on this device (see `warmup_ms`).
+    pub fn preroll(&self, device: &crate::gpu::DeviceInfo) -> std::time::Duration {
+        let ms = match (self.frames, self.warmup_ms) {
+            (0..=1, _) => 0,
+            (_, Some(ms)) => ms,
+            _ if device.device_type == "CPU" => 0,
+            _ => PREROLL_GPU_MS,
+        };
+        std::time::Duration::from_millis(ms.into())
     }
 }
 
@@ -79,6 +101,7 @@ impl Default for RenderOptions {
             ruler: false,
             runs: 1,
             warmup: None,
+            warmup_ms: None,
         }
     }
 }
@@ -236,6 +259,7 @@ pub fn render_scene(
     }
     let mut out = last.expect("at least one run");
     let r = &out.report;
+    let preroll_ms = r.preroll_ms;
     out.report = RunReport::new(
         &ctx.info,
         r.setup.clone(),
@@ -244,6 +268,7 @@ pub fn render_scene(
         warmup as usize,
         r.memory,
     );
+    out.report.preroll_ms = preroll_ms;
     Ok(out)
 }
 
@@ -401,7 +426,8 @@ fn run(
     let progress = Progress::new(opts.frames, opts.progress);
     // What the frames compute once and keep (SH, shadows, stretch maps …).
     let mut kept = Kept::default();
-    for _ in 0..opts.frames {
+    // The frame's graph with its readbacks; whether the GPU meters exposure.
+    let build = |kept: &Kept| -> Result<(Graph, bool)> {
         let mut g = Graph::with_kept(kept.clone());
         let images = frame.graph(&mut g, view, screen)?;
         if let (Some(ldr), Some(r)) = (&images.ldr, &ldr_readback) {
@@ -410,18 +436,34 @@ fn run(
         // After the 8-bit readback, which waits for the tone map's reads.
         if let Some(m) = &images.metered {
             exposure_readback.buffer_pass(&mut g, m);
-            gpu_metered = true;
         }
         if let Some(r) = &hdr_readback {
             r.image_pass(&mut g, &images.image);
         }
+        Ok((g, images.metered.is_some()))
+    };
+    let preroll = opts.preroll(&ctx.info);
+    // The frames of the pre-roll, rendered before the second frame and not reported.
+    let mut unreported = 0..0;
+    for i in 0..opts.frames {
+        if i == 1 && !preroll.is_zero() {
+            let (start, until) = (executor.frames_submitted(), Instant::now() + preroll);
+            while Instant::now() < until {
+                let compiled = executor.compile(build(&kept)?.0)?;
+                reports.extend(executor.submit(compiled)?);
+            }
+            unreported = start..executor.frames_submitted();
+        }
+        let (g, metered) = build(&kept)?;
+        gpu_metered |= metered;
         let compiled = executor.compile(g)?;
         kept = compiled.plan.kept.clone();
         plan = compiled.plan.to_string();
         reports.extend(executor.submit(compiled)?);
-        progress.update(reports.len(), reports.last().and_then(|r| r.gpu_frame_ns));
+        progress.update(i as usize + 1, reports.last().and_then(|r| r.gpu_frame_ns));
     }
     reports.extend(executor.finish()?);
+    reports.retain(|r| !unreported.contains(&r.frame));
     drop(progress);
     let mut hdr = match &hdr_readback {
         Some(b) => Some(
@@ -468,7 +510,8 @@ fn run(
         (ev, metered.is_some()),
     );
     let warmup = opts.warmup_frames()? as usize;
-    let report = RunReport::new(&ctx.info, run_setup, (w, h), reports, warmup, memory);
+    let mut report = RunReport::new(&ctx.info, run_setup, (w, h), reports, warmup, memory);
+    report.preroll_ms = preroll.as_millis() as u64;
     Ok(RenderOutput {
         width: w,
         height: h,

@@ -44,6 +44,8 @@ pub struct SweepOptions {
     pub chains: Vec<Chain>,
     /// Frames per point (the first is warm-up).
     pub frames: u32,
+    /// Pre-roll per point (render::RenderOptions::warmup_ms).
+    pub warmup_ms: Option<u32>,
     pub reference_resolution: u32,
 }
 
@@ -152,13 +154,14 @@ pub fn validate(opts: &SweepOptions) -> Result<()> {
     Ok(())
 }
 
-/// The linear HDR image of `view` for `variant`, and the run report.
+/// The linear HDR image of `view` for `variant`, and the run report
+/// (`frames`, and the pre-roll as render::RenderOptions::warmup_ms).
 fn render(
     ctx: &Arc<Context>,
     scene: &mut Scene,
     variant: Variant,
     view: View,
-    frames: u32,
+    (frames, warmup_ms): (u32, Option<u32>),
 ) -> Result<(Vec<f32>, RunReport)> {
     scene.file.render.irradiance_resolution = variant.resolution;
     scene.file.skin.kernel = variant.kernel;
@@ -168,6 +171,7 @@ fn render(
         scene,
         &RenderOptions {
             frames,
+            warmup_ms,
             hdr: true,
             ruler: view == View::FINAL,
             view,
@@ -216,9 +220,15 @@ impl<'a> Session<'a> {
             &format!("sweep: reference {} (2 renders)", reference.id()),
             2,
         );
-        let (ref_final, report) = render(ctx, &mut scene, reference, View::FINAL, 1)?;
+        let (ref_final, report) = render(ctx, &mut scene, reference, View::FINAL, (1, None))?;
         task.add(1);
-        let (ref_diffuse, _) = render(ctx, &mut scene, reference, View::named("diffuse"), 1)?;
+        let (ref_diffuse, _) = render(
+            ctx,
+            &mut scene,
+            reference,
+            View::named("diffuse"),
+            (1, None),
+        )?;
         drop(task);
         Ok(Self {
             ctx,
@@ -235,9 +245,15 @@ impl<'a> Session<'a> {
 
     /// Renders and measures one point.
     pub fn point(&mut self, variant: Variant) -> Result<Point> {
-        let (ctx, frames) = (self.ctx, self.opts.frames);
+        let (ctx, frames) = (self.ctx, (self.opts.frames, self.opts.warmup_ms));
         let (image, report) = render(ctx, &mut self.scene, variant, View::FINAL, frames)?;
-        let (diffuse, _) = render(ctx, &mut self.scene, variant, View::named("diffuse"), 1)?;
+        let (diffuse, _) = render(
+            ctx,
+            &mut self.scene,
+            variant,
+            View::named("diffuse"),
+            (1, None),
+        )?;
         let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
         // The chain by the tag its passes declare (skin::TAG).
         let is_ruler = |p: &PassStats| crate::profile::is_ruler(&p.name);

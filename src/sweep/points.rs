@@ -146,6 +146,7 @@ mod tests {
             kernels: vec![Kernel::Deon7, Kernel::Accurate],
             chains: vec![Chain::Full, Chain::Adaptive],
             frames: 3,
+            warmup_ms: None,
             reference_resolution: 2048,
         }
     }
