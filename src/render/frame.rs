@@ -272,6 +272,8 @@ impl Passes {
         let (variant, s) = (&inputs.variant, &inputs.samplers);
         let res = skin.resolution;
         let constant_stretch = (!skin.stretch_correction).then(|| mean_stretch(&scene.mesh, res));
+        // Light through thin skin: the final pass reads what `translucent` draws.
+        let transmits = skin.transmission > 0.0;
         Ok(Self {
             direct: DirectPass::new(p, variant)?,
             stretch: StretchMaps::new(
@@ -283,8 +285,8 @@ impl Passes {
             )?,
             irradiance: IrradiancePass::new(p, variant, res)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
-            shade: ShadePass::new(p, variant, skin.transmission > 0.0, skin.blur_amount < 1.0)?,
-            translucent: TranslucentPass::new(p, variant, res, skin.transmission > 0.0)?,
+            shade: ShadePass::new(p, variant, transmits, skin.blur_amount < 1.0)?,
+            translucent: TranslucentPass::new(p, variant, res, transmits)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res, false)?,
             hard_visibility: VisibilityPass::new(p, variant, res, true)?,
