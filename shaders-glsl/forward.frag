@@ -3,6 +3,7 @@
 // lights), with the tangent-space normal map. Replaced by texture-space diffusion
 // in the skin passes; kept as the `diffuse-direct` view.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #include "sh.glsl"
 const float PI_F = 3.14159265358979;

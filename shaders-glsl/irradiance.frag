@@ -6,6 +6,7 @@
 // normal, albedo^mix and (ρs, m) were drawn once per render by surface.frag over
 // this same raster and are read texel for texel.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #include "sh.glsl"
 layout(binding = 1) uniform sampler2D surface_normal_params;

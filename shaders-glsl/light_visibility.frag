@@ -7,6 +7,7 @@
 // (alpha 1 on the mesh, 0 in the gutter) so that the shading passes
 // renormalise where bilinear taps reach past a chart's border.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #define SHADOW_ATLAS 1
 #define SHADOW_DEPTH 2
@@ -25,7 +26,7 @@ void main() {
     vec3 ng = normalize(v_normal);
     float v[9] = float[9](1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0);
     int lights = HARD ? SHADOWED_LIGHTS & ~SOFT_LIGHTS : SOFT_LIGHTS;
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
+    [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         if ((lights & (1 << i)) == 0) continue;
         int slot = bitCount(lights & ((1 << i) - 1));
         if (HARD) {

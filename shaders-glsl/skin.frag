@@ -8,6 +8,7 @@
 // through it adds to the diffuse (docs/skin.md, "Transmission"), from the
 // texture translucent.frag drew once per lighting for the side shaded.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #include "envmap.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
@@ -105,7 +106,7 @@ void main() {
     }
     vec3 sss = diffuse * pow(albedo, vec3(1.0 - pc.mix_pre)) / PI * exit;
     vec3 spec = vec3(0.0);
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
+    [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e = light_irradiance(i, v_position, v_normal, n, v_uv, l);
         spec += e * ks_specular(n, l, v, light_lobe(i, params));

@@ -12,6 +12,7 @@
 // final pass renormalises where its bilinear lookup reaches past a chart's
 // border. Nothing here depends on the camera.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #define SHADOW_ATLAS 1
 #define SHADOW_DEPTH 2
@@ -49,7 +50,7 @@ vec3 transmittance(float d) {
 // shading normal n.
 vec3 transmitted(vec3 x, vec3 ng, vec3 n, vec2 params) {
     vec3 sum = vec3(0.0);
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
+    [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         if ((SHADOWED_LIGHTS & (1 << i)) == 0) continue;
         vec3 l;
         float dist;

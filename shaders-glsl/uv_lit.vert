@@ -7,6 +7,7 @@
 // the vertex), plus the environment's light through thin skin
 // (light/transmission.rs; the lights' is the final pass's), zero without them.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
 #include "sh_basis.glsl"
 #include "incident.glsl"
@@ -33,7 +34,7 @@ void main() {
     vec3 L[9];
     for (int j = 0; j < 9; ++j) L[j] = lighting.sh[j].rgb;
     vec3 through = rgb_transfer_irradiance(TRANSMITTED, L);
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
+    [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         float dist;
         vec3 e = light_incident(i, position, l, dist);

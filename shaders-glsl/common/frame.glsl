@@ -12,8 +12,12 @@ layout(std140, binding = 0) uniform Frame {
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
     vec4 params;            // x: 0 (free), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;
-// Fixed for a render (frame::ShaderVariant): the driver unrolls the light loop and
-// drops dead branches, which a CPU driver would otherwise run with masked lanes.
+// Fixed for a render (frame::ShaderVariant): the driver drops dead branches, which
+// a CPU driver would otherwise run with masked lanes. Loops over the lights are
+// marked [[unroll]] (GL_EXT_control_flow_attributes): lavapipe (Mesa 22.3) does
+// not unroll a body that large by itself (nir_opt_loop_unroll's cost limit), and
+// the rolled loop made the lit close-up's skin pass 1.7× slower
+// (docs/performance.md).
 layout(constant_id = 0) const int LIGHT_COUNT = 0;
 layout(constant_id = 1) const bool OCCLUSION = true;
 layout(constant_id = 2) const bool ROUGHNESS_MAP = false;

@@ -25,7 +25,7 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {
 #ifdef ENERGY_CONSERVING
     e *= diffuse_transmission_uniform(spec_params);
 #endif
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
+    [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e_light = light_irradiance(i, x, ng, n, uv, l);
         float n_dot_l = max(dot(n, l), 0.0);

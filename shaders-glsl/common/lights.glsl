@@ -129,7 +129,7 @@ float soft_visibility(int i, ShadowMap m, vec3 s, vec3 ng, vec2 step) {
     mat2 turn = soft_shadow_turn();
     float search = clamp((s.z - m.nearest) * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float distance = 0.0, count = 0.0;
-    for (int k = 0; k < BLOCKER_TAPS; ++k) {
+    [[unroll]] for (int k = 0; k < BLOCKER_TAPS; ++k) {
         vec2 d = turn * vogel_tap(k, BLOCKER_TAPS) * search * step;
         vec2 p = clamp(s.xy + d, lo, hi);
         float receiver = s.z + dot(slope, p - s.xy);
@@ -145,7 +145,7 @@ float soft_visibility(int i, ShadowMap m, vec3 s, vec3 ng, vec2 step) {
     if (count == float(BLOCKER_TAPS)) return 0.0;
     float radius = clamp(distance / count * range * tan_r / texel, 1.0, MAX_SOFT_TEXELS);
     float lit = 0.0;
-    for (int k = 0; k < PCF_TAPS; ++k) {
+    [[unroll]] for (int k = 0; k < PCF_TAPS; ++k) {
         vec2 p = clamp(s.xy + turn * vogel_tap(k, PCF_TAPS) * radius * step, lo, hi);
         lit += texture(shadow_atlas, vec3(p, s.z + dot(slope, p - s.xy)));
     }
@@ -246,8 +246,8 @@ float hard_shadow(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
     vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
     float lit = 0.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
+        [[unroll]] for (int dx = -1; dx <= 1; ++dx) {
             lit += texture(shadow_atlas, vec3(s.xy + vec2(dx, dy) * step, s.z));
         }
     }
