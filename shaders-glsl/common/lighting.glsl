@@ -2,9 +2,9 @@
 // occlusion, E = Σ L_i·T_i from the interpolated per-vertex transfer (the paper's
 // eq. 13); without, Ramamoorthi & Hanrahan at the shading normal — plus the
 // explicit lights at x (geometric normal ng). Needs frame.glsl, sh.glsl,
-// lights.glsl, the Lighting buffer and v_t* (and v_indirect with INDIRECT:
-// the light the skin reflects onto itself and the sky's through thin skin,
-// light/interreflection.rs, light/transmission.rs).
+// lights.glsl (and GL_EXT_control_flow_attributes), the Lighting buffer and v_t*
+// (and v_indirect with INDIRECT: the light the skin reflects onto itself and the
+// sky's through thin skin, light/interreflection.rs, light/transmission.rs).
 // With ENERGY_CONSERVING (and ks_specular.glsl), each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
 // what the specular reflects does not enter the skin.
 vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {

@@ -9,7 +9,8 @@
 // the visibility textures, three lights each, coverage-premultiplied.
 // translucent.frag defines SHADOW_DEPTH too, for the thickness light passes
 // through (shadow_thickness: transmission).
-// Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler.
+// Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler, and
+// GL_EXT_control_flow_attributes for its [[unroll]] loops (frame.glsl says why).
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
 #include "incident.glsl"
 
