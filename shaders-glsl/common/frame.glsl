@@ -14,9 +14,9 @@ layout(std140, binding = 0) uniform Frame {
 } frame;
 // Fixed for a render (frame::ShaderVariant): the driver drops dead branches, which
 // a CPU driver would otherwise run with masked lanes. Loops over the lights are
-// marked [[unroll]] (GL_EXT_control_flow_attributes): lavapipe (Mesa 22.3) does
-// not unroll a body that large by itself (nir_opt_loop_unroll's cost limit), and
-// the rolled loop made the lit close-up's skin pass 1.7× slower
+// marked [[unroll]] (GL_EXT_control_flow_attributes): without it lavapipe (Mesa
+// 22.3) left a body that large rolled (nir_opt_loop_unroll's cost limit, it
+// seems), and the lit close-up's skin pass took 1.7× as long
 // (docs/performance.md).
 layout(constant_id = 0) const int LIGHT_COUNT = 0;
 layout(constant_id = 1) const bool OCCLUSION = true;
