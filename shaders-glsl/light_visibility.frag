@@ -23,6 +23,8 @@ layout(location = 2) out vec4 visibility2;
 layout(constant_id = 5) const bool HARD = false;
 
 void main() {
+    shading_dpdx = dFdx(v_position);
+    shading_dpdy = dFdy(v_position);
     vec3 ng = normalize(v_normal);
     float v[9] = float[9](1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0);
     int lights = HARD ? SHADOWED_LIGHTS & ~SOFT_LIGHTS : SOFT_LIGHTS;

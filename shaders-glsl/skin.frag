@@ -74,6 +74,8 @@ vec3 lookup(sampler2D t) {
 }
 
 void main() {
+    shading_dpdx = dFdx(v_position);
+    shading_dpdy = dFdy(v_position);
     vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
                  + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
                  + pc.weights[4].rgb * lookup(blur5) + pc.weights[5].rgb * lookup(blur6);

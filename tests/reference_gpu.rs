@@ -254,27 +254,26 @@ fn nose_shadow_edge_against_the_reference() {
             "whole mesh only"
         };
         println!(
-            "light {diameter}°, 2048² shadow map, {map}: edge {offset:+.2} mm into the \
-             reference's shadow, penumbra {penumbra:.2} mm (reference {penumbra_ref:.2} mm)"
+            "light {diameter}°, 2048² shadow map, {map}: edge {offset:+.3} mm into the \
+             reference's shadow, penumbra {penumbra:.3} mm (reference {penumbra_ref:.3} mm)"
         );
     }
     for pair in results.chunks(2) {
         let (whole, focus) = (pair[0], pair[1]);
         // Issue 22's target: the edge within 0.25 mm of the reference's
-        // (measured: +0.16 mm hard, +0.06 mm for 3°; the whole mesh's map
+        // (measured: +0.17 mm hard, +0.06 mm for 3°; the whole mesh's map
         // alone: +1.13 and +1.01 mm).
         assert!(focus[2].abs() <= 0.25, "{results:?}");
         assert!(focus[2].abs() < whole[2].abs(), "{results:?}");
     }
-    // The 3° source's penumbra (1.6 mm in the reference) within 25 % of the
-    // reference's (measured: 1.52 mm); the hard light's, a pixel or two in the
-    // reference, at most twice it.
+    // Issue 22's target for both lights, with the focus map: the penumbra
+    // within 25 % of the reference's (measured: 3°, 1.52 mm of 1.60; hard,
+    // 0.37 mm of 0.30, a pixel or two and the 3 × 3 mean: the filter follows
+    // the pixel's footprint, and was 0.47 mm at a fixed 3 × 3 texels).
     assert!(results[2][4] > results[0][4] + 0.5, "{results:?}");
-    assert!(
-        (results[3][3] / results[3][4] - 1.0).abs() <= 0.25,
-        "{results:?}"
-    );
-    assert!(results[1][3] <= 2.0 * results[1][4], "{results:?}");
+    for focus in [results[1], results[3]] {
+        assert!((focus[3] / focus[4] - 1.0).abs() <= 0.25, "{results:?}");
+    }
 }
 
 /// (offset, penumbra, reference penumbra) in pixels per pixel of edge: the

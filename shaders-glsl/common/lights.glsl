@@ -11,8 +11,16 @@
 // through (shadow_thickness: transmission).
 // Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler, and
 // GL_EXT_control_flow_attributes for its [[unroll]] loops (frame.glsl says why).
+// A fragment shader that looks up a hard light's shadow sets shading_dpdx/dpdy
+// first.
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
 #include "incident.glsl"
+
+// The shaded point's position derivatives across its pixel (or, over a UV
+// raster, its texel): dFdx/dFdy of the position, taken by the fragment shader
+// in uniform control flow before any lookup. A point or directional source
+// casts a step; its filter covers this footprint and no more (hard_shadow).
+vec3 shading_dpdx = vec3(0.0), shading_dpdy = vec3(0.0);
 
 // Acne offsets, in shadow-map texels: along the normal (normal-offset shadows,
 // Holbert 2011) and towards the light (a constant depth bias in world units).
@@ -240,12 +248,24 @@ float stored_hard_visibility(int i) {
 #endif
 
 // Fraction of light i (without an angular size) that reaches x (surface normal
-// ng) from direction l: 3×3 bilinear PCF.
+// ng) from direction l: 3×3 bilinear PCF, its taps spread over the shaded
+// sample's footprint in the map (issue 22: the penumbra follows the light's
+// size, here none, not the map's texel). Taps d texels apart have variance
+// 2d²/3 plus a bilinear tap's 1/6; the footprint's box of f texels, f²/12:
+// d = √(f²/8 − ¼), from 0 (one bilinear comparison's worth) to 1 texel (the
+// reach the acne offsets allow for). docs/lighting.md.
 float hard_shadow(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     ShadowMap m = shadow_map(i, x, 0.0);
     vec3 s = shadow_point(m, frame.light_vec[i].w > 0.5, x, ng, l, dist).xyz;
     if (s.z <= 0.0 || s.z >= 1.0) return 1.0;   // outside the light's frustum
-    vec2 step = 1.0 / vec2(textureSize(shadow_atlas, 0));
+    vec2 size = vec2(textureSize(shadow_atlas, 0));
+    // The footprint in atlas texels: the map's projection differentiated at x.
+    vec4 c = m.to_atlas * vec4(x, 1.0);
+    vec4 cx = m.to_atlas * vec4(shading_dpdx, 0.0), cy = m.to_atlas * vec4(shading_dpdy, 0.0);
+    vec2 fx = (cx.xy - c.xy / c.w * cx.w) / c.w * size;
+    vec2 fy = (cy.xy - c.xy / c.w * cy.w) / c.w * size;
+    float footprint = max(length(fx), length(fy));
+    vec2 step = min(sqrt(max(footprint * footprint / 8.0 - 0.25, 0.0)), 1.0) / size;
     float lit = 0.0;
     [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
         [[unroll]] for (int dx = -1; dx <= 1; ++dx) {
