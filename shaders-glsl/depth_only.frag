@@ -13,5 +13,6 @@ layout(location = 6) in vec3 v_t678;
 layout(location = 7) in vec3 v_s012;
 layout(location = 8) in vec3 v_s345;
 layout(location = 9) in vec3 v_s678;
+layout(location = 10) in vec3 v_indirect;
 
 void main() {}

@@ -14,40 +14,45 @@
 layout(binding = 1) uniform sampler2D albedo_tex;
 layout(binding = 2) uniform sampler2D normal_tex;
 #define SHADOW_ATLAS 3
-#define SOFT_VISIBILITY 18
-// Bindings 18..20: the soft lights' visibility.
+#define SOFT_VISIBILITY 20
+// Bindings 20..22: the soft lights' visibility.
 #include "lights.glsl"
 // The light transmitted through thin skin, front and back (skin/translucent.rs).
-layout(binding = 21) uniform sampler2D translucent_front;
-layout(binding = 22) uniform sampler2D translucent_back;
-// binding 4: the per-vertex transfer and lobe visibility, read by skin.vert.
-#define ENV_SPECULAR 5
+layout(binding = 23) uniform sampler2D translucent_front;
+layout(binding = 24) uniform sampler2D translucent_back;
+// Bindings 4 and 6: the per-vertex transfer and lobe visibility, and the
+// interreflected and transmitted transfer, read by skin.vert. 5: the
+// environment's SH (sh_reduce.comp), for the unblurred levels.
+layout(std140, binding = 5) uniform Lighting { vec4 sh[9]; } lighting;
+#define ENV_SPECULAR 7
 #include "env_specular.glsl"
-layout(binding = 6) uniform sampler2D irradiance;
-layout(binding = 7) uniform sampler2D blur1;
-layout(binding = 8) uniform sampler2D blur2;
-layout(binding = 9) uniform sampler2D blur3;
-layout(binding = 10) uniform sampler2D blur4;
-layout(binding = 11) uniform sampler2D blur5;
-layout(binding = 12) uniform sampler2D blur6;
-#define SPEC_BECKMANN 13
-#define SPEC_ALBEDO 14
-#define SPEC_REGIONS 15
-#define SPEC_INTENSITY 16
-#define SPEC_ROUGHNESS 17
+layout(binding = 8) uniform sampler2D irradiance;
+layout(binding = 9) uniform sampler2D blur1;
+layout(binding = 10) uniform sampler2D blur2;
+layout(binding = 11) uniform sampler2D blur3;
+layout(binding = 12) uniform sampler2D blur4;
+layout(binding = 13) uniform sampler2D blur5;
+layout(binding = 14) uniform sampler2D blur6;
+#define SPEC_BECKMANN 15
+#define SPEC_ALBEDO 16
+#define SPEC_REGIONS 17
+#define SPEC_INTENSITY 18
+#define SPEC_ROUGHNESS 19
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "lobe_visibility.glsl"
-// weights: rgb the Gaussians' weights (w: padding). mode: 0 final, 1 diffuse only, 2 specular only, 3 the
-// transmitted light only. blur_amount: the share of the blurred levels, the
-// rest the unblurred irradiance (the paper's menu). transmission: the scale on
-// the transmitted light (skin.transmission).
+// weights: rgb the Gaussians' weights (w: padding), those of the unblurred
+// levels zero and summed in pixel_weight instead. mode: 0 final, 1 diffuse
+// only, 2 specular only, 3 the transmitted light only. blur_amount: the share
+// of the blurred levels, the rest the unblurred irradiance (the paper's menu).
+// transmission: the scale on the transmitted light (skin.transmission).
 layout(push_constant) uniform Push {
     vec4 weights[6];
     float mix_pre;
     uint mode;
     float blur_amount;
     float transmission;
+    vec4 pixel_weight;
 } pc;
 // The pass is built with the transmitted term (skin::shade::ShadePass::new);
 // without it the shader is the one without the term.
@@ -55,6 +60,11 @@ layout(constant_id = 5) const bool TRANSMISSION = false;
 // With blur_amount < 1 the unblurred irradiance is mixed in; at 1 (the
 // default) the pass is built without its lookup (skin::shade::ShadePass::new).
 layout(constant_id = 6) const bool UNBLURRED = true;
+// Levels the chain leaves unblurred (skin::chain: the adaptive chain's first,
+// narrower than SKIP_SIGMA_TEXELS) are the irradiance itself: with PIXEL_LEVELS
+// it is evaluated at the pixel, as the irradiance pass does at a texel, instead
+// of read from its texture (skin::shade::ShadePass::new).
+layout(constant_id = 7) const bool PIXEL_LEVELS = false;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -65,7 +75,12 @@ layout(location = 6) in vec3 v_t678;
 layout(location = 7) in vec3 v_s012;
 layout(location = 8) in vec3 v_s345;
 layout(location = 9) in vec3 v_s678;
+layout(location = 10) in vec3 v_indirect;
 layout(location = 0) out vec4 color;
+#include "sh.glsl"
+#define INDIRECT
+#define ENERGY_CONSERVING
+#include "lighting.glsl"
 
 // A UV target at v_uv, normalised by its coverage.
 vec3 lookup(sampler2D t) {
@@ -79,14 +94,20 @@ void main() {
     vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
                  + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
                  + pc.weights[4].rgb * lookup(blur5) + pc.weights[5].rgb * lookup(blur6);
-    vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
+    vec2 params = specular_params(v_uv);
+    vec3 albedo = texture(albedo_tex, v_uv).rgb;
+    // The irradiance pass's term at this pixel, the front side's as in its
+    // texture.
+    if (PIXEL_LEVELS) {
+        blurred += pc.pixel_weight.rgb * irradiance_at(v_position, v_normal, n, v_uv, params)
+                 * pow(albedo, vec3(pc.mix_pre));
+    }
+    vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.
     bool back_side = dot(v_normal, v) < 0.0;
     if (back_side) n = -n;
-    vec2 params = specular_params(v_uv);
-    vec3 albedo = texture(albedo_tex, v_uv).rgb;
     float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
     // §14.3), taken from the diffuse and given to the environment's specular.

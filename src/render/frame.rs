@@ -268,6 +268,7 @@ impl Passes {
         inputs: &FrameInputs,
         lighting: &Lighting,
         skin: &SkinSettings,
+        levels: &[Level],
     ) -> Result<Self> {
         let (variant, s) = (&inputs.variant, &inputs.samplers);
         let res = skin.resolution;
@@ -285,7 +286,13 @@ impl Passes {
             )?,
             irradiance: IrradiancePass::new(p, variant, res)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
-            shade: ShadePass::new(p, variant, transmits, skin.blur_amount < 1.0)?,
+            shade: ShadePass::new(
+                p,
+                variant,
+                transmits,
+                skin.blur_amount < 1.0,
+                chain::unblurred_levels(levels) > 0,
+            )?,
             translucent: TranslucentPass::new(p, variant, res, transmits)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res, false)?,
@@ -408,7 +415,7 @@ impl Frame {
         let pipelines = Pipelines::new(ctx);
         Ok(Self {
             tables,
-            passes: Passes::new(&pipelines, scene, &inputs, &lighting, &skin)?,
+            passes: Passes::new(&pipelines, scene, &inputs, &lighting, &skin, &levels)?,
             pipelines,
             ruler,
             sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, rotation, intensity)?,
@@ -626,7 +633,7 @@ impl Frame {
             &profile,
         );
         let size = (hdr.desc.width, hdr.desc.height);
-        let mut depth = p.shade.depth(g, inputs, &light.shadows, size);
+        let mut depth = p.shade.depth(g, inputs, (&light.shadows, &light.sh), size);
         skybox::pass(
             g,
             &self.pipelines,
@@ -641,8 +648,10 @@ impl Frame {
             mix: self.skin.mix,
             blur_amount: self.skin.blur_amount,
             mode,
+            pixel_levels: chain::unblurred_levels(&self.levels),
         };
         let images = ShadeImages {
+            sh: &light.sh,
             irradiance: &irradiance,
             levels: &BlurChain::select(&irradiance, &blurred, &self.levels),
             shadows: &light.shadows,

@@ -132,6 +132,12 @@ pub fn plan(profile: &Profile, chain: Chain, resolution: u32, texels_per_mm: f32
     levels
 }
 
+/// How many leading levels are the unblurred irradiance itself (no blur before
+/// them): the final pass evaluates those per pixel (skin::shade).
+pub fn unblurred_levels(levels: &[Level]) -> usize {
+    levels.iter().take_while(|l| l.sigma_mm.is_none()).count()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@ use super::tables::SpecularTables;
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
-use crate::graph::{Graph, ImageHandle, LoadOp};
+use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
@@ -20,6 +20,8 @@ struct ShadePush {
     mode: u32,
     blur_amount: f32,
     transmission: f32,
+    /// rgb: the summed weights of the levels evaluated per pixel.
+    pixel_weight: [f32; 4],
 }
 
 /// The profile weights, albedo split and output of the final pass.
@@ -35,10 +37,16 @@ pub struct ShadeSettings {
     /// Share of the blurred levels in the diffuse term (SkinSettings::blur_amount).
     pub blur_amount: f32,
     pub mode: ShadeMode,
+    /// The leading levels that are the unblurred irradiance
+    /// (skin::chain::unblurred_levels), evaluated per pixel when the pass was
+    /// built for it ([`ShadePass::new`]).
+    pub pixel_levels: usize,
 }
 
 /// The frame's images the final pass reads.
 pub struct ShadeImages<'a> {
+    /// The environment's SH coefficients (light::sh_pass).
+    pub sh: &'a BufferHandle,
     /// The unblurred irradiance.
     pub irradiance: &'a ImageHandle,
     /// The six blur levels (skin::blur::BlurChain::select).
@@ -91,10 +99,12 @@ pub struct ShadePass {
     /// wherever they are drawn before the faces in front: ~25 % of the pass).
     depth: Arc<Pipeline>,
     pipeline: Arc<Pipeline>,
+    /// Built with skin.frag's PIXEL_LEVELS.
+    pixel_levels: bool,
 }
 
 /// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
-/// `UNBLURRED`.
+/// `UNBLURRED` and `PIXEL_LEVELS`.
 const TRANSMISSION_CONSTANT: usize = 5;
 
 impl ShadePass {
@@ -102,17 +112,21 @@ impl ShadePass {
     /// specialization constant: without it the shader is the one without the
     /// term, so `skin.transmission = 0` costs nothing and changes no bit).
     /// `unblurred`: with the unblurred irradiance mixed in (`skin.blur_amount`
-    /// < 1; at 1 its lookup would be multiplied by 0).
+    /// < 1; at 1 its lookup would be multiplied by 0). `pixel_levels`: the
+    /// chain leaves its first level unblurred, and the pass evaluates the
+    /// irradiance per pixel for it (skin.frag's PIXEL_LEVELS).
     pub fn new(
         pipelines: &Pipelines,
         variant: &ShaderVariant,
         transmission: bool,
         unblurred: bool,
+        pixel_levels: bool,
     ) -> Result<Self> {
         let mut specialization = variant.specialization().to_vec();
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
         specialization.push(u32::from(unblurred));
+        specialization.push(u32::from(pixel_levels));
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
@@ -131,6 +145,7 @@ impl ShadePass {
         Ok(Self {
             depth: mesh("depth_only.frag", &[], true)?,
             pipeline: mesh("skin.frag", &[HDR_FORMAT], false)?,
+            pixel_levels,
         })
     }
 
@@ -140,12 +155,13 @@ impl ShadePass {
         &self,
         g: &mut Graph,
         inputs: &FrameInputs,
-        shadows: &ImageHandle,
+        (shadows, sh): (&ImageHandle, &BufferHandle),
         (w, h): (u32, u32),
     ) -> ImageHandle {
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
         let s = &inputs.samplers;
-        // skin.vert's bindings (frame 0, transfer 4) in skin.frag's order.
+        // skin.vert's bindings (frame 0, transfer 4, SH 5, RGB transfer 6) in
+        // skin.frag's order.
         let pre = g
             .simple_pass("skin_depth", &self.depth)
             .uniform(&inputs.uniforms)
@@ -153,6 +169,8 @@ impl ShadePass {
             .texture(&inputs.normal, &s.linear)
             .sample(shadows, &s.shadow)
             .buffer(&inputs.transfer)
+            .read_uniform(sh)
+            .buffer(&inputs.rgb_transfer)
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
         depth
@@ -172,9 +190,15 @@ impl ShadePass {
         depth: &mut ImageHandle,
     ) {
         let s = &inputs.samplers;
+        let pixel_levels = if self.pixel_levels {
+            settings.pixel_levels
+        } else {
+            0
+        };
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
-        // specular environment, irradiance, six blur levels, the specular
-        // bindings, the soft lights' visibility, the translucent textures.
+        // SH, RGB transfer, specular environment, irradiance, six blur levels,
+        // the specular bindings, the soft lights' visibility, the translucent
+        // textures.
         let mut pass = g
             .simple_pass("skin", &self.pipeline)
             .uniform(&inputs.uniforms)
@@ -182,6 +206,8 @@ impl ShadePass {
             .texture(&inputs.normal, &s.linear)
             .sample(images.shadows, &s.shadow)
             .buffer(&inputs.transfer)
+            .read_uniform(images.sh)
+            .buffer(&inputs.rgb_transfer)
             .sample(images.specular_env, &s.linear)
             .sample(images.irradiance, &s.linear);
         for level in images.levels {
@@ -197,11 +223,19 @@ impl ShadePass {
             .color(hdr, LoadOp::Load)
             .depth(depth, LoadOp::Load)
             .constants(&ShadePush {
-                weights: std::array::from_fn(|i| settings.weights[i].extend(0.0).into()),
+                weights: std::array::from_fn(|i| {
+                    let w = settings.weights[i] * f32::from(u8::from(i >= pixel_levels));
+                    w.extend(0.0).into()
+                }),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
                 blur_amount: settings.blur_amount,
                 transmission: settings.transmission,
+                pixel_weight: settings.weights[..pixel_levels]
+                    .iter()
+                    .sum::<glam::Vec3>()
+                    .extend(0.0)
+                    .into(),
             });
         inputs.mesh.draw(pass);
     }
