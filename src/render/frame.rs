@@ -291,7 +291,7 @@ impl Passes {
                 variant,
                 transmits,
                 skin.blur_amount < 1.0,
-                chain::unblurred_levels(levels) > 0,
+                chain::unblurred_levels(levels),
             )?,
             translucent: TranslucentPass::new(p, variant, res, transmits)?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
@@ -648,7 +648,6 @@ impl Frame {
             mix: self.skin.mix,
             blur_amount: self.skin.blur_amount,
             mode,
-            pixel_levels: chain::unblurred_levels(&self.levels),
         };
         let images = ShadeImages {
             sh: &light.sh,

@@ -37,10 +37,6 @@ pub struct ShadeSettings {
     /// Share of the blurred levels in the diffuse term (SkinSettings::blur_amount).
     pub blur_amount: f32,
     pub mode: ShadeMode,
-    /// The leading levels that are the unblurred irradiance
-    /// (skin::chain::unblurred_levels), evaluated per pixel when the pass was
-    /// built for it ([`ShadePass::new`]).
-    pub pixel_levels: usize,
 }
 
 /// The frame's images the final pass reads.
@@ -99,8 +95,9 @@ pub struct ShadePass {
     /// wherever they are drawn before the faces in front: ~25 % of the pass).
     depth: Arc<Pipeline>,
     pipeline: Arc<Pipeline>,
-    /// Built with skin.frag's PIXEL_LEVELS.
-    pixel_levels: bool,
+    /// The leading levels that are the unblurred irradiance, evaluated per
+    /// pixel (skin.frag's PIXEL_LEVELS when above 0).
+    pixel_levels: usize,
 }
 
 /// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
@@ -112,21 +109,22 @@ impl ShadePass {
     /// specialization constant: without it the shader is the one without the
     /// term, so `skin.transmission = 0` costs nothing and changes no bit).
     /// `unblurred`: with the unblurred irradiance mixed in (`skin.blur_amount`
-    /// < 1; at 1 its lookup would be multiplied by 0). `pixel_levels`: the
-    /// chain leaves its first level unblurred, and the pass evaluates the
-    /// irradiance per pixel for it (skin.frag's PIXEL_LEVELS).
+    /// < 1; at 1 its lookup would be multiplied by 0). `pixel_levels`: how
+    /// many leading levels the chain leaves unblurred
+    /// (skin::chain::unblurred_levels); the pass evaluates the irradiance per
+    /// pixel for them (skin.frag's PIXEL_LEVELS).
     pub fn new(
         pipelines: &Pipelines,
         variant: &ShaderVariant,
         transmission: bool,
         unblurred: bool,
-        pixel_levels: bool,
+        pixel_levels: usize,
     ) -> Result<Self> {
         let mut specialization = variant.specialization().to_vec();
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
         specialization.push(u32::from(unblurred));
-        specialization.push(u32::from(pixel_levels));
+        specialization.push(u32::from(pixel_levels > 0));
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
@@ -190,11 +188,6 @@ impl ShadePass {
         depth: &mut ImageHandle,
     ) {
         let s = &inputs.samplers;
-        let pixel_levels = if self.pixel_levels {
-            settings.pixel_levels
-        } else {
-            0
-        };
         // The order of skin.frag: frame, albedo, normal, shadow atlas, transfer,
         // SH, RGB transfer, specular environment, irradiance, six blur levels,
         // the specular bindings, the soft lights' visibility, the translucent
@@ -223,15 +216,16 @@ impl ShadePass {
             .color(hdr, LoadOp::Load)
             .depth(depth, LoadOp::Load)
             .constants(&ShadePush {
+                // The per-pixel levels' weights go to pixel_weight.
                 weights: std::array::from_fn(|i| {
-                    let w = settings.weights[i] * f32::from(u8::from(i >= pixel_levels));
+                    let w = settings.weights[i] * if i < self.pixel_levels { 0.0 } else { 1.0 };
                     w.extend(0.0).into()
                 }),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
                 blur_amount: settings.blur_amount,
                 transmission: settings.transmission,
-                pixel_weight: settings.weights[..pixel_levels]
+                pixel_weight: settings.weights[..self.pixel_levels]
                     .iter()
                     .sum::<glam::Vec3>()
                     .extend(0.0)
