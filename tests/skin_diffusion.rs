@@ -676,15 +676,16 @@ fn blur_width_zero_and_blur_amount_zero_give_the_unblurred_irradiance() {
         e(&blurred, &direct),
         e(&half, &mid),
     );
-    // Both settings read the irradiance texture unblurred: the same image up
-    // to f16 rounding and the profile weights' sums (1 ± 0.001).
-    assert!(mean_difference(&no_width, &no_amount) < 0.002);
-    // And that is the irradiance-derived Lambert term, up to sampling the
-    // irradiance at 1024² instead of per pixel.
-    assert!(mean_difference(&no_width, &direct) < 0.03);
+    // Width 0 leaves every level unblurred, and the final pass evaluates the
+    // irradiance per pixel (skin::chain::unblurred_levels): the Lambert term
+    // itself up to the profile weights' sums, 1 ± 0.001 (measured 0.03 %).
+    // Amount 0 reads the irradiance texture: the same term sampled at 1024²
+    // instead of per pixel (0.25 %).
+    assert!(mean_difference(&no_width, &direct) < 0.002);
+    assert!(mean_difference(&no_amount, &direct) < 0.03);
     // The blur moves light across the shadow edge and around the curvature:
-    // measurably further from the Lambert term.
-    assert!(mean_difference(&blurred, &direct) > 2.0 * mean_difference(&no_width, &direct));
+    // measurably further from the Lambert term (0.44 %).
+    assert!(mean_difference(&blurred, &direct) > 5.0 * mean_difference(&no_width, &direct));
     // The amount mixes linearly.
     assert!(mean_difference(&half, &mid) < 0.001);
 }
