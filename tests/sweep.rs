@@ -127,9 +127,13 @@ fn sweep_help_documents_its_options_and_bad_values_exit_2() {
 }
 
 #[test]
-fn the_adaptive_chain_stays_within_half_a_percent_of_the_full_chain() {
+fn the_adaptive_chain_stays_within_one_percent_of_the_full_chain() {
     // The lit close-up (shadow edges, normal-map detail), small and without
-    // occlusion to keep the test short.
+    // occlusion to keep the test short. The adaptive chain's first level is
+    // the irradiance evaluated per pixel, the full chain's a texture of 0.6 mm
+    // texels: 0.84 % apart (0.3–0.5 % when both read the texture). Against the
+    // sweep's 4096² reference the adaptive chain is the closer of the two
+    // (docs/performance.md, "The unblurred levels per pixel").
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes/close-up-lights.toml");
     let mut file = load_scene(&path).unwrap();
     file.render.width = 320;
@@ -154,5 +158,5 @@ fn the_adaptive_chain_stays_within_half_a_percent_of_the_full_chain() {
     println!("adaptive against full at 1024²: {e:?}");
     assert!(e.pixels > 10_000, "{e:?}");
     assert!(e.rmse_rel > 0.0, "the chains should differ: {e:?}");
-    assert!(e.rmse_rel < 0.005, "{e:?}");
+    assert!(e.rmse_rel < 0.01, "{e:?}");
 }
