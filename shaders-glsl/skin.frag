@@ -41,8 +41,8 @@ layout(binding = 14) uniform sampler2D blur6;
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
 #include "lobe_visibility.glsl"
-// weights: rgb the Gaussians' weights (w: padding), those of the unblurred
-// levels zero and summed in pixel_weight instead. mode: 0 final, 1 diffuse
+// weights: rgb the Gaussians' weights (w: padding); pixel_weight: the sum of
+// the per-pixel levels' (PIXEL_LEVELS). mode: 0 final, 1 diffuse
 // only, 2 specular only, 3 the transmitted light only. blur_amount: the share
 // of the blurred levels, the rest the unblurred irradiance (the paper's menu).
 // transmission: the scale on the transmitted light (skin.transmission).
@@ -60,11 +60,11 @@ layout(constant_id = 5) const bool TRANSMISSION = false;
 // With blur_amount < 1 the unblurred irradiance is mixed in; at 1 (the
 // default) the pass is built without its lookup (skin::shade::ShadePass::new).
 layout(constant_id = 6) const bool UNBLURRED = true;
-// Levels the chain leaves unblurred (skin::chain: the adaptive chain's first,
-// narrower than SKIP_SIGMA_TEXELS) are the irradiance itself: with PIXEL_LEVELS
-// it is evaluated at the pixel, as the irradiance pass does at a texel, instead
-// of read from its texture (skin::shade::ShadePass::new).
-layout(constant_id = 7) const bool PIXEL_LEVELS = false;
+// The leading levels the chain leaves unblurred (skin::chain: the adaptive
+// chain's first, narrower than SKIP_SIGMA_TEXELS) are the irradiance itself:
+// PIXEL_LEVELS of them, evaluated at the pixel as the irradiance pass does at a
+// texel, and not read from their textures (skin::shade::ShadePass::new).
+layout(constant_id = 7) const uint PIXEL_LEVELS = 0;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -88,18 +88,23 @@ vec3 lookup(sampler2D t) {
     return b.rgb / max(b.a, 1e-4);
 }
 
+// Level k's share, read from its texture t unless it is evaluated per pixel
+// (a constant: the lookup is compiled out).
+vec3 level(uint k, sampler2D t) {
+    return k < PIXEL_LEVELS ? vec3(0.0) : pc.weights[k].rgb * lookup(t);
+}
+
 void main() {
     shading_dpdx = dFdx(v_position);
     shading_dpdy = dFdy(v_position);
-    vec3 blurred = pc.weights[0].rgb * lookup(blur1) + pc.weights[1].rgb * lookup(blur2)
-                 + pc.weights[2].rgb * lookup(blur3) + pc.weights[3].rgb * lookup(blur4)
-                 + pc.weights[4].rgb * lookup(blur5) + pc.weights[5].rgb * lookup(blur6);
+    vec3 blurred = level(0u, blur1) + level(1u, blur2) + level(2u, blur3)
+                 + level(3u, blur4) + level(4u, blur5) + level(5u, blur6);
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     // The irradiance pass's term at this pixel, the front side's as in its
     // texture.
-    if (PIXEL_LEVELS) {
+    if (PIXEL_LEVELS > 0u) {
         blurred += pc.pixel_weight.rgb * irradiance_at(v_position, v_normal, n, v_uv, params)
                  * pow(albedo, vec3(pc.mix_pre));
     }

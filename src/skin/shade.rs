@@ -96,7 +96,7 @@ pub struct ShadePass {
     depth: Arc<Pipeline>,
     pipeline: Arc<Pipeline>,
     /// The leading levels that are the unblurred irradiance, evaluated per
-    /// pixel (skin.frag's PIXEL_LEVELS when above 0).
+    /// pixel, and does not read from their textures (skin.frag's PIXEL_LEVELS).
     pixel_levels: usize,
 }
 
@@ -124,7 +124,7 @@ impl ShadePass {
         debug_assert_eq!(specialization.len(), TRANSMISSION_CONSTANT);
         specialization.push(u32::from(transmission));
         specialization.push(u32::from(unblurred));
-        specialization.push(u32::from(pixel_levels > 0));
+        specialization.push(pixel_levels as u32);
         // The same vertex shader for both, so the shading pass's depth equals the
         // pre-pass's exactly.
         let mesh = |fragment, color_formats, depth_write| {
@@ -216,11 +216,7 @@ impl ShadePass {
             .color(hdr, LoadOp::Load)
             .depth(depth, LoadOp::Load)
             .constants(&ShadePush {
-                // The per-pixel levels' weights go to pixel_weight.
-                weights: std::array::from_fn(|i| {
-                    let w = settings.weights[i] * if i < self.pixel_levels { 0.0 } else { 1.0 };
-                    w.extend(0.0).into()
-                }),
+                weights: settings.weights.map(|w| w.extend(0.0).into()),
                 mix_pre: settings.mix,
                 mode: settings.mode as u32,
                 blur_amount: settings.blur_amount,
