@@ -159,6 +159,45 @@ fn texture_space_diffusion_against_the_exact_reference() {
     }
 }
 
+/// The reference convolves the light that enters the skin: the sky's light
+/// through thin skin, which the chain adds to its irradiance as its stand-in
+/// for a thin part's far side, is left out of it (the reference's chords
+/// through the skin carry that light themselves), so its result is the same
+/// with transmission on and off, while the chain's is not.
+#[test]
+fn the_exact_reference_leaves_out_the_chains_transmitted_light() {
+    use dermis::scene::file::Chain;
+    use dermis::sweep::diffusion::{run, DiffusionOptions};
+    let read = |transmission: f32| {
+        let mut scene = scene_by_name(None).unwrap();
+        scene.render.irradiance_resolution = 256;
+        (scene.render.width, scene.render.height) = (24, 30);
+        scene.skin.transmission = transmission;
+        let dir = std::env::temp_dir().join(format!(
+            "dermis-entering-{}-{transmission}",
+            std::process::id()
+        ));
+        let opts = DiffusionOptions {
+            scene,
+            chains: vec![Chain::Full],
+            stride: 8,
+            out_dir: Some(dir.clone()),
+        };
+        common::with_gpu(|ctx| run(ctx, &opts, |_| {}).unwrap());
+        let file = |name: &str| std::fs::read(dir.join(name)).unwrap();
+        let files = (file("reference.exr"), file("full.exr"));
+        std::fs::remove_dir_all(&dir).unwrap();
+        files
+    };
+    let (reference_on, chain_on) = read(1.0);
+    let (reference_off, chain_off) = read(0.0);
+    assert!(chain_on != chain_off, "transmission changed nothing");
+    assert!(
+        reference_on == reference_off,
+        "the reference read the transmitted light"
+    );
+}
+
 /// The nose's shadow on the cheek under one directional light (black
 /// environment), `--view direct` against the CPU reference's shadow rays: the
 /// visibility V = image / image without shadows on both sides, the mean offset

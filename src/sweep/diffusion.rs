@@ -171,12 +171,17 @@ pub fn run(
         scene.file.skin.chain = chain;
         let names: Vec<String> = std::iter::once("irradiance".to_string())
             .chain((1..=6).map(|k| format!("blur{k}")))
+            .chain(std::iter::once("translucent_front".to_string()))
             .collect();
         let images = stored_images(ctx, &scene, &names)?;
-        let levels: Vec<Level> = images.into_iter().map(Level::from).collect();
+        let mut levels: Vec<Level> = images.into_iter().map(Level::from).collect();
+        let translucent = levels.pop().expect("translucent_front");
         let reference = match &mut reference {
             Some(r) => r,
-            None => reference.insert(exact(&scene, &skin, &levels[0], opts.stride)?),
+            None => {
+                let entering = entering_irradiance(ctx, &scene, &levels[0])?;
+                reference.insert(exact(&scene, &skin, &entering, opts.stride)?)
+            }
         };
         // The chain's diffused irradiance as the final pass combines its levels.
         let chain_at = |uv: Vec2, e: Vec3| {
@@ -187,11 +192,19 @@ pub fn run(
                 .sum();
             e.lerp(blurred, skin.blur_amount)
         };
+        // At a texel, the shadowed lights' light through thin skin too, as
+        // the final pass adds it (skin.frag: the translucent texture of the
+        // front side × skin.transmission × albedo^mix; 1×1 and empty when the
+        // term is off). Through the camera it comes with the transmission view.
+        let through = |uv: Vec2| {
+            let t = translucent.at(uv).unwrap_or(Vec3::ZERO);
+            t * skin.transmission * rgba8(&scene.albedo, uv).truncate().powf(skin.mix)
+        };
         let diffused: Vec<Vec3> = reference
             .texels
             .iter()
             .zip(&reference.irradiance)
-            .map(|(t, &e)| chain_at(t.uv, e))
+            .map(|(t, &e)| chain_at(t.uv, levels[0].at(t.uv).unwrap_or(e)) + through(t.uv))
             .collect();
         let pixel_diffused: Vec<Vec3> = reference
             .pixels
@@ -378,6 +391,7 @@ fn write_uv(
 
 /// A read-back level: coverage-premultiplied RGBA, sampled as the final pass
 /// does (bilinear at the texel's UV, divided by coverage).
+#[derive(Clone)]
 struct Level {
     width: u32,
     height: u32,
@@ -402,6 +416,21 @@ impl Level {
         });
         (c.w > MIN_COVERAGE).then(|| c.truncate() / c.w)
     }
+}
+
+/// The irradiance the reference convolves: the chain's, less the sky's light
+/// through thin skin (light::transmission), which the chain adds to its
+/// irradiance as its stand-in for the far side of a thin part and which the
+/// reference carries itself, by its chords through the skin (docs/skin.md,
+/// "Exact diffusion"). Without transmission, the chain's own irradiance.
+fn entering_irradiance(ctx: &Arc<Context>, scene: &Scene, irradiance: &Level) -> Result<Level> {
+    if scene.file.skin.transmission <= 0.0 {
+        return Ok(irradiance.clone());
+    }
+    let mut scene = scene.clone();
+    scene.file.skin.transmission = 0.0;
+    let mut images = stored_images(ctx, &scene, &["irradiance".to_string()])?;
+    Ok(Level::from(images.remove(0)))
 }
 
 /// The exact diffusion at the covered texels of the irradiance, and the masks.
@@ -459,22 +488,21 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
         .zip(&e)
         .map(|(t, &e)| exact(t.position, t.normal, e))
         .unzip();
+    let pixel_e: Vec<Vec3> = pixels
+        .iter()
+        .map(|p| irradiance.at(p.uv).unwrap_or(Vec3::ZERO))
+        .collect();
     let (pixel_diffused, pixel_inside): (Vec<Vec3>, Vec<Vec3>) = pixels
         .par_iter()
-        .map(|p| {
-            exact(
-                p.position,
-                p.normal,
-                irradiance.at(p.uv).unwrap_or(Vec3::ZERO),
-            )
-        })
+        .zip(&pixel_e)
+        .map(|(p, &e)| exact(p.position, p.normal, e))
         .unzip();
     let seconds = start.elapsed().as_secs_f64();
     drop(task);
     let ids = region_ids(scene, texels.iter().map(|t| (t.uv, t.position)));
     let pixel_ids = region_ids(scene, pixels.iter().map(|p| (p.uv, p.position)));
     let masks = texel_masks(&ids, &texels, &edges, &diffused, &e);
-    let pixel_masks = pixel_masks(&pixel_ids);
+    let pixel_masks = pixel_masks(&pixel_ids, &pixel_diffused, &pixel_e);
     Ok(Reference {
         texels,
         irradiance: e,
@@ -555,7 +583,6 @@ fn texel_masks(
     diffused: &[Vec3],
     irradiance: &[Vec3],
 ) -> Vec<(String, Vec<bool>)> {
-    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let mut masks = region_masks(ids);
     masks.push((
         format!("UV seams (≤ {SEAM_MM} mm)"),
@@ -564,16 +591,23 @@ fn texel_masks(
             .map(|t| edges.to_seam(t.position).is_some_and(|d| d <= SEAM_MM))
             .collect(),
     ));
-    masks.push((
+    masks.push(scattering_mask(diffused, irradiance));
+    masks.push(("all".to_string(), vec![true; texels.len()]));
+    masks
+}
+
+/// Where scattering changes the light by more than SCATTERING_CHANGE: the
+/// reference's diffused luminance D against the irradiance's E, |D − E| > share · D.
+fn scattering_mask(diffused: &[Vec3], irradiance: &[Vec3]) -> (String, Vec<bool>) {
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    (
         format!("scattering > {:.0} %", 100.0 * SCATTERING_CHANGE),
         diffused
             .iter()
             .zip(irradiance)
             .map(|(&d, &e)| (lum(d) - lum(e)).abs() > SCATTERING_CHANGE * lum(d))
             .collect(),
-    ));
-    masks.push(("all".to_string(), vec![true; texels.len()]));
-    masks
+    )
 }
 
 /// The face (every region but the last, neck/other) and each region.
@@ -589,12 +623,11 @@ fn region_masks(ids: &[usize]) -> Vec<(String, Vec<bool>)> {
         .collect()
 }
 
-/// The camera's pixel masks: the face, the ears, all.
-fn pixel_masks(ids: &[usize]) -> Vec<(String, Vec<bool>)> {
-    let mut masks: Vec<_> = region_masks(ids)
-        .into_iter()
-        .filter(|(name, _)| name == "face" || name == "ears")
-        .collect();
+/// The camera's pixel masks: the face, each region, where scattering changes
+/// the light by more than SCATTERING_CHANGE, all.
+fn pixel_masks(ids: &[usize], diffused: &[Vec3], irradiance: &[Vec3]) -> Vec<(String, Vec<bool>)> {
+    let mut masks = region_masks(ids);
+    masks.push(scattering_mask(diffused, irradiance));
     masks.push(("all".to_string(), vec![true; ids.len()]));
     masks
 }
