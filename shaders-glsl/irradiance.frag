@@ -3,8 +3,9 @@
 // (Ramamoorthi & Hanrahan 2001) plus the explicit lights (shadowed), less what the
 // specular reflects (energy conservation on entry), times the pre-scatter
 // albedo^mix. Alpha is coverage (1 on the mesh, 0 in the gutter). The shading
-// normal, albedo^mix and (ρs, m) were drawn once per render by surface.frag over
-// this same raster and are read texel for texel.
+// normal, albedo^mix, (ρs, m) and the environment's share 1 − ρs·Ā(m) were
+// drawn once per render by surface.frag over this same raster and are read
+// texel for texel.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"
@@ -45,6 +46,7 @@ void main() {
     ivec2 texel = ivec2(gl_FragCoord.xy);
     vec4 s = texelFetch(surface_normal_params, texel, 0);
     vec3 n = octahedral_decode(s.xy * 2.0 - 1.0);
-    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, s.zw);
-    irradiance = vec4(e * texelFetch(surface_albedo_mix, texel, 0).rgb, 1.0);
+    vec4 a = texelFetch(surface_albedo_mix, texel, 0);
+    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, s.zw, a.a);
+    irradiance = vec4(e * a.rgb, 1.0);
 }

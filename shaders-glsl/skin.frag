@@ -102,21 +102,25 @@ void main() {
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
-    // The irradiance pass's term at this pixel, the front side's as in its
-    // texture.
-    if (PIXEL_LEVELS > 0u) {
-        blurred += pc.pixel_weight.rgb * irradiance_at(v_position, v_normal, n, v_uv, params)
-                 * pow(albedo, vec3(pc.mix_pre));
-    }
-    vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
     // Two-sided by the geometric normal, whatever the mesh's winding.
     bool back_side = dot(v_normal, v) < 0.0;
+    float n_dot_v = clamp(dot(back_side ? -n : n, v), 0.0, 1.0);
+    // (A(N·V, m), Ā(m)): the specular's albedo toward the viewer and over
+    // the hemisphere.
+    vec2 albedos = specular_albedos(n_dot_v, params.y);
+    // The irradiance pass's term at this pixel, the front side's as in its
+    // texture; the environment's share that enters, 1 − ρs·Ā(m), from the
+    // fetch above.
+    if (PIXEL_LEVELS > 0u) {
+        float env_share = max(1.0 - params.x * albedos.y, 0.0);
+        blurred += pc.pixel_weight.rgb * irradiance_at(v_position, v_normal, n, v_uv, params, env_share)
+                 * pow(albedo, vec3(pc.mix_pre));
+    }
+    vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;
     if (back_side) n = -n;
-    float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
     // ρs·A(N·V, m): what the oil layer reflects toward the viewer (GPU Gems 3
     // §14.3), taken from the diffuse and given to the environment's specular.
-    vec2 albedos = specular_albedos(n_dot_v, params.y);
     float reflected = params.x * albedos.x;
     // What the oil layer reflects back inward on exit stays in the skin and
     // leaves later: the exit factor 1 − ρs·A(N·V) renormalised by its

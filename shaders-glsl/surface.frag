@@ -4,7 +4,8 @@
 // texel for texel (skin/irradiance.rs; issue 24). Two RGBA16 UNORM targets
 // (1.5·10⁻⁵ steps over [0, 1], finer than half floats there): the normal-mapped
 // shading normal, octahedral (common/octahedral.glsl), with the specular's (ρs,
-// m); and the pre-scatter albedo^mix (GPU Gems 3 §14.5).
+// m); and the pre-scatter albedo^mix (GPU Gems 3 §14.5) with the share of the
+// environment's light that enters, 1 − ρs·Ā(m) (ks_specular.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
 layout(binding = 1) uniform sampler2D albedo_tex;
@@ -29,5 +30,6 @@ void main() {
     vec2 params = specular_params(v_uv);
     vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
     normal_params = vec4(octahedral_encode(n) * 0.5 + 0.5, params);
-    albedo_mix = vec4(pow(texture(albedo_tex, v_uv).rgb, vec3(pc.mix_pre)), 1.0);
+    albedo_mix = vec4(pow(texture(albedo_tex, v_uv).rgb, vec3(pc.mix_pre)),
+                      diffuse_transmission_uniform(params));
 }

@@ -5,9 +5,11 @@
 // lights.glsl (and GL_EXT_control_flow_attributes), the Lighting buffer and v_t*
 // (and v_indirect with INDIRECT: the light the skin reflects onto itself and the
 // sky's through thin skin, light/interreflection.rs, light/transmission.rs).
-// With ENERGY_CONSERVING (and ks_specular.glsl), each light is scaled by 1 − ρs·A(N·L, m) and the environment by 1 − ρs·Ā(m):
-// what the specular reflects does not enter the skin.
-vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {
+// With ENERGY_CONSERVING (and ks_specular.glsl), each light is scaled by
+// 1 − ρs·A(N·L, m): what the specular reflects does not enter the skin. The
+// environment is scaled by env_share, its share that enters: 1 − ρs·Ā(m)
+// (diffuse_transmission_uniform, which the caller has at hand), 1 without.
+vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params, float env_share) {
     vec3 e;
     if (OCCLUSION) {
         e = lighting.sh[0].rgb * v_t012.x + lighting.sh[1].rgb * v_t012.y
@@ -21,10 +23,7 @@ vec3 irradiance_at(vec3 x, vec3 ng, vec3 n, vec2 uv, vec2 spec_params) {
     } else {
         e = sh_irradiance(lighting.sh, n);
     }
-    e = max(e, vec3(0.0));
-#ifdef ENERGY_CONSERVING
-    e *= diffuse_transmission_uniform(spec_params);
-#endif
+    e = max(e, vec3(0.0)) * env_share;
     [[unroll]] for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec3 l;
         vec3 e_light = light_irradiance(i, x, ng, n, uv, l);

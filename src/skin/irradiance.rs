@@ -1,7 +1,8 @@
 //! Irradiance in texture space (GPU Gems 3 §14.5): the mesh rasterised by its
 //! UVs, lit by the SH environment and the shadowed explicit lights, times
 //! albedo^mix. What no light changes — the normal-mapped shading normal,
-//! albedo^mix and the specular's (ρs, m) — is drawn once per render over the
+//! albedo^mix, the specular's (ρs, m) and the share of the environment's light
+//! it lets in, 1 − ρs·Ā(m) — is drawn once per render over the
 //! same raster (`surface`, kept: the mesh, its maps and the skin settings are
 //! fixed for a render) and read back texel for texel by every frame
 //! (`irradiance`), instead of five map and table fetches per texel (issue 24;
@@ -16,7 +17,8 @@ use crate::graph::{Access, BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
 
-/// The surface textures (surface.frag): (octahedral n, ρs, m) and albedo^mix.
+/// The surface textures (surface.frag): (octahedral n, ρs, m) and (albedo^mix,
+/// 1 − ρs·Ā(m)).
 const SURFACE: [&str; 2] = ["surface_normal", "surface_albedo"];
 /// Their format: 16-bit fixed point over [0, 1], finer there than the half
 /// floats of UV_FORMAT (the irradiance moved by up to 0.2 % with those).
