@@ -118,8 +118,22 @@ fn type_name(t: vk::PhysicalDeviceType) -> &'static str {
     }
 }
 
+/// Held while a context is created or destroyed: the loader, layers and
+/// drivers are not all safe against instances and devices made and destroyed
+/// on several threads at once (one of the GPU tests, which each make their own
+/// context in parallel, died of SIGSEGV at start-up in CI; Vulkan-Loader#220 and
+/// kvark/blade#336 are the same race elsewhere). Rendering is not serialised.
+static LIFECYCLE: Mutex<()> = Mutex::new(());
+
+fn lifecycle() -> MutexGuard<'static, ()> {
+    LIFECYCLE
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
 impl Context {
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
+        let _lifecycle = lifecycle();
         // SAFETY: loading libvulkan runs its initialisers; nothing else is in flight.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::NoLoader(e.to_string()))?;
         let validation = options
@@ -256,6 +270,7 @@ impl Context {
 
 impl Drop for Context {
     fn drop(&mut self) {
+        let _lifecycle = lifecycle();
         unsafe {
             let _ = self.device.device_wait_idle();
             // Device memory goes back before the device itself.
