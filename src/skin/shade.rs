@@ -95,8 +95,9 @@ pub struct ShadePass {
     /// wherever they are drawn before the faces in front: ~25 % of the pass).
     depth: Arc<Pipeline>,
     pipeline: Arc<Pipeline>,
-    /// The leading levels that are the unblurred irradiance, evaluated per
-    /// pixel, and does not read from their textures (skin.frag's PIXEL_LEVELS).
+    /// The leading levels that are the unblurred irradiance: the pass
+    /// evaluates them per pixel and does not read their textures (skin.frag's
+    /// PIXEL_LEVELS).
     pixel_levels: usize,
 }
 

@@ -2,11 +2,14 @@
 //! diffusion over the surface (skin::reference). The scene's irradiance and
 //! blur levels are rendered and read back as stored; at the covered texels of
 //! the irradiance's resolution (every `stride`-th), the reference convolves the
-//! same irradiance with the same profile in 3-D, and both give the diffused
-//! irradiance the final pass shades, `mix(E, Σ wₖ·blurₖ, blur_amount)`. The
-//! relative error of luminance (sweep::metric::relative) is reported per face
-//! region of the region map, near UV seams, where scattering changes the light
-//! by more than 20 %, and over the face. docs/skin.md, "Exact diffusion".
+//! light that enters the skin (the same irradiance, less the sky's light through
+//! thin skin, which its chords carry themselves) with the same profile in 3-D,
+//! and both give the diffused irradiance the final pass shades,
+//! `mix(E, Σ wₖ·blurₖ, blur_amount)` (the chain's texels with the lights'
+//! transmitted light the final pass adds). The relative error of luminance
+//! (sweep::metric::relative) is reported per face region of the region map,
+//! near UV seams, where scattering changes the light by more than 20 %, and over
+//! the face, at texels and through the camera. docs/skin.md, "Exact diffusion".
 
 use super::metric::{relative, RelativeError};
 use super::output::write_side_by_side;
