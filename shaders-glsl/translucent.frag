@@ -3,8 +3,9 @@
 // space, once per lighting (skin/translucent.rs; docs/skin.md, "Transmission"):
 // translucent shadow maps (d'Eon & Luebke §14.5.3; Jimenez et al. 2010). For
 // each light the surface faces away from (dot(ng, l) < 0, so a lit face, whose
-// thickness is ≈ 0, is not lit twice), the light's irradiance on the
-// light-facing surface — its normal taken as −n, the light entering less what
+// thickness is ≈ 0, is not lit twice) and whose light enters by a surface
+// facing away from this one (a thin part's far side), the light's irradiance
+// on the light-facing surface — its normal taken as −n, the light entering less what
 // the specular reflects there (this point's ρs, m) — through the thickness the
 // shadow map gives, T(d) = Σ wᵢ exp(−d²/2vᵢ). Both sides of the surface, as
 // the final pass shades both: front (the mesh's normal) and back (reversed);
@@ -56,6 +57,11 @@ vec3 transmitted(vec3 x, vec3 ng, vec3 n, vec2 params) {
         float dist;
         vec3 e = light_incident(i, x, l, dist);
         if (dot(ng, l) >= 0.0) continue;
+        // Only light that enters on the far side of a thin part, whose surface
+        // faces away from x's (as light/transmission.rs counts the sky's): light
+        // entering just before a terminator, or at the mesh's open cut, is what
+        // the chain already carries along the surface.
+        if (dot(entry_normal(i, x), ng) >= 0.0) continue;
         float facing = max(dot(-n, l), 0.0);
         if (facing <= 0.0) continue;
         facing *= diffuse_transmission(facing, light_lobe(i, params));

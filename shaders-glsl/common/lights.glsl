@@ -8,7 +8,8 @@
 // shading passes, which define SOFT_VISIBILITY: the first of three bindings of
 // the visibility textures, three lights each, coverage-premultiplied.
 // translucent.frag defines SHADOW_DEPTH too, for the thickness light passes
-// through (shadow_thickness: transmission).
+// through and the surface it enters by (shadow_thickness, entry_normal:
+// transmission).
 // Expects SHADOW_ATLAS: the atlas with a depth-comparison sampler, and
 // GL_EXT_control_flow_attributes for its [[unroll]] loops (frame.glsl says why).
 // A fragment shader that looks up a hard light's shadow sets shading_dpdx/dpdy
@@ -211,6 +212,33 @@ float shadow_thickness(int i, vec3 x, float dist) {
         t = (p.z - z) * range;
     }
     return dot(w, max(t, vec4(0.0)));
+}
+
+// The normal, facing the light, of the surface light i's map holds on the way
+// to x (where its light enters the skin), from the slope of the map's depth:
+// with the map's rows a, b, c, d (atlas u, v, depth, w), a surface of depth
+// z(u, v) has the world normal z_u(a − u·d) + z_v(b − v·d) − (c − z·d), up to a
+// positive scale (the gradient of z(u, v) − depth through the projection).
+// Unnormalised; across the light's silhouette the slope is steep and the
+// normal turns sideways.
+vec3 entry_normal(int i, vec3 x) {
+    mat4 m = frame.light_shadow[i];
+    vec4 s = m * vec4(x, 1.0);
+    vec3 p = s.xyz / s.w;
+    vec2 size = vec2(textureSize(shadow_depth, 0));
+    vec2 tiles = frame.params.zw;
+    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
+    vec2 uv = clamp(p.xy, lo, lo + 1.0 / tiles - 1.0 / size);
+    // Texels (u0, v1), (u1, v1), (u1, v0), (u0, v0).
+    vec4 z = textureGather(shadow_depth, uv, 0);
+    float zu = 0.5 * ((z.y + z.z) - (z.x + z.w)) * size.x;
+    float zv = 0.5 * ((z.x + z.y) - (z.z + z.w)) * size.y;
+    float zc = 0.25 * (z.x + z.y + z.z + z.w);
+    vec3 a = vec3(m[0][0], m[1][0], m[2][0]);
+    vec3 b = vec3(m[0][1], m[1][1], m[2][1]);
+    vec3 c = vec3(m[0][2], m[1][2], m[2][2]);
+    vec3 d = vec3(m[0][3], m[1][3], m[2][3]);
+    return zu * (a - p.x * d) + zv * (b - p.y * d) - (c - zc * d);
 }
 #endif
 
