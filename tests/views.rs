@@ -5,12 +5,14 @@
 
 mod common;
 
+use dermis::post::debug::DebugView;
 use dermis::render::sheet::{COLUMNS, TILE};
 use dermis::render::{
     compare_occlusion, debug_sheet, render_scene, sheet_views, views, RenderOptions, Screen, View,
 };
 use dermis::scene::file::SceneFile;
 use dermis::scene::Scene;
+use dermis::skin::shade::ShadeMode;
 
 const SIZE: (u32, u32) = (96, 120);
 
@@ -27,9 +29,9 @@ fn scene() -> Scene {
 /// few pixels only (the far sides of thin parts: docs/skin.md, "Only from a far
 /// side"), so it must only not be blank; the rest vary smoothly.
 fn least_colours(view: &View) -> usize {
-    match view.name() {
-        "regions" => 5,
-        "transmission" => 3,
+    match view {
+        View::Screen(Screen::Skin(ShadeMode::Transmission)) => 3,
+        View::Screen(Screen::Debug(DebugView::Regions)) => 5,
         _ => 32,
     }
 }

@@ -172,6 +172,19 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 #endif
 
 #ifdef SHADOW_DEPTH
+// The depths light i's map stores about x: the four texels around x's point
+// p in the map, (u0, v1), (u1, v1), (u1, v0), (u0, v0), read at uv, which
+// keeps them inside this light's tile of the atlas.
+vec4 stored_depths(int i, vec3 x, out vec3 p, out vec2 uv) {
+    vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
+    p = s.xyz / s.w;
+    vec2 size = vec2(textureSize(shadow_depth, 0));
+    vec2 tiles = frame.params.zw;
+    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
+    uv = clamp(p.xy, lo, lo + 1.0 / tiles - 1.0 / size);
+    return textureGather(shadow_depth, uv, 0);
+}
+
 // The distance (mm) light i's ray to x travels inside the mesh before reaching
 // x: from the first surface the atlas stores along that ray to x (translucent
 // shadow maps, d'Eon & Luebke §14.5.3; Jimenez et al. 2010). Looked up at x's
@@ -188,17 +201,10 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 // map: the profile's transmittance changes over millimetres, its 0.33 mm texels
 // do, and choosing the focus map cost the final pass 7-10 % when it looked the thickness up per pixel.
 float shadow_thickness(int i, vec3 x, float dist) {
-    vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
-    vec3 p = s.xyz / s.w;
-    vec2 size = vec2(textureSize(shadow_depth, 0));
-    // The taps stay inside this light's tile of the atlas.
-    vec2 tiles = frame.params.zw;
-    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
-    vec2 hi = lo + 1.0 / tiles - 1.0 / size;
-    vec2 uv = clamp(p.xy, lo, hi);
-    // Texels (u0, v1), (u1, v1), (u1, v0), (u0, v0).
-    vec4 z = textureGather(shadow_depth, uv, 0);
-    vec2 f = fract(uv * size - 0.5);
+    vec3 p;
+    vec2 uv;
+    vec4 z = stored_depths(i, x, p, uv);
+    vec2 f = fract(uv * vec2(textureSize(shadow_depth, 0)) - 0.5);
     vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
     float range = frame.light_params[i].y;
     vec4 t;
@@ -222,15 +228,11 @@ float shadow_thickness(int i, vec3 x, float dist) {
 // Unnormalised; across the light's silhouette the slope is steep and the
 // normal turns sideways.
 vec3 entry_normal(int i, vec3 x) {
-    mat4 m = frame.light_shadow[i];
-    vec4 s = m * vec4(x, 1.0);
-    vec3 p = s.xyz / s.w;
+    vec3 p;
+    vec2 uv;
+    vec4 z = stored_depths(i, x, p, uv);
     vec2 size = vec2(textureSize(shadow_depth, 0));
-    vec2 tiles = frame.params.zw;
-    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
-    vec2 uv = clamp(p.xy, lo, lo + 1.0 / tiles - 1.0 / size);
-    // Texels (u0, v1), (u1, v1), (u1, v0), (u0, v0).
-    vec4 z = textureGather(shadow_depth, uv, 0);
+    mat4 m = frame.light_shadow[i];
     float zu = 0.5 * ((z.y + z.z) - (z.x + z.w)) * size.x;
     float zv = 0.5 * ((z.x + z.y) - (z.z + z.w)) * size.y;
     float zc = 0.25 * (z.x + z.y + z.z + z.w);
