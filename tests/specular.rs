@@ -5,6 +5,8 @@
 //!   casting, in the screen-space direct view and in the UV-space irradiance;
 //! - environment specular: exact under a constant environment, and the
 //!   prefiltered environment against brute-force integration of a CC0 map.
+//! - the furnace: a white and a grey sphere under a uniform sky, the whole
+//!   frame against the closed form.
 
 mod common;
 
@@ -531,32 +533,45 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
     );
 }
 
-#[test]
-fn a_white_sphere_under_a_white_sky_reflects_it_whole() {
-    // The white furnace through the whole frame: albedo 1, no occlusion, a
-    // uniform L. The specular takes ρs·Ā(m) of the light entering and reflects
-    // ρs·A(N·V, m)·L toward the viewer; the diffuse leaves with the exit factor
-    // renormalised by 1 − ρs·Ā(m): in all, L at every angle.
+/// The furnace through the whole frame: a sphere of albedo `rho` (`albedo`, its
+/// texture), no occlusion, a uniform L. The specular takes ρs·Ā(m) of the light
+/// entering and reflects ρs·A(N·V, m)·L toward the viewer; the diffuse enters
+/// with albedo^mix, leaves with albedo^(1−mix) and the exit factor renormalised
+/// by 1 − ρs·Ā(m): ρ·L·(1 − ρs·A) + ρs·A·L at every angle, L where ρ = 1.
+fn furnace(albedo: Texture, rho: f32) {
     let radiance = 2.0;
     let mut s = scene(
         sphere(Vec3::ZERO, R, 96, 48, (0.0, 1.0)),
         Vec::new(),
         EnvMap::uniform(Vec3::splat(radiance), 64, 32),
     );
-    s.albedo = Texture::solid([255, 255, 255, 255], Encoding::Srgb);
+    s.albedo = albedo;
     let img = render(&s, View::FINAL);
     let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
         .into_iter()
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            (cos >= 0.3).then_some(radiance)
+            let reflected = rho_s() * specular_albedo(cos, DEFAULT_M);
+            (cos >= 0.3).then_some(radiance * (rho * (1.0 - reflected) + reflected))
         })
         .collect();
     for c in 0..3 {
-        let (n, _) = compare("white furnace", |i| img[i * 4 + c], &expected);
+        let (n, _) = compare("furnace", |i| img[i * 4 + c], &expected);
         assert!(n > 10_000, "{n}");
     }
+}
+
+#[test]
+fn a_white_sphere_under_a_white_sky_reflects_it_whole() {
+    furnace(Texture::solid([255, 255, 255, 255], Encoding::Srgb), 1.0);
+}
+
+#[test]
+fn a_grey_sphere_under_a_white_sky_reflects_its_albedo() {
+    // Where the albedo is not 1 its split between entry and exit (mix) must
+    // multiply back to the albedo: a white sphere cannot tell.
+    furnace(Texture::solid([128, 128, 128, 255], Encoding::Srgb), ALBEDO);
 }
 
 /// Relative errors (max over channels) of the GPU prefiltered environment of
