@@ -9,9 +9,10 @@ use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::{upload_texture, Readback};
 use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::post::glow::{kernel, Glow};
-use dermis::post::meter::{self, KEY, LUMINANCE};
+use dermis::post::meter::{self, KEY};
 use dermis::render::{render_scene, RenderOptions};
 use dermis::scene::file::load_scene;
+use dermis::scene::texture::LUMINANCE;
 use dermis::scene::Scene;
 use std::path::Path;
 use std::sync::Arc;
@@ -125,7 +126,7 @@ fn metering_exposes_the_lit_scan_to_the_key() {
     let (mut sum, mut count) = (0.0f64, 0);
     let scale = out.exposure.exp2();
     for p in hdr.chunks_exact(4).filter(|p| p[3] > 0.5) {
-        let l = LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2];
+        let l = glam::Vec3::from_slice(&p[..3]).dot(LUMINANCE);
         sum += f64::from(l * scale).max(1e-9).ln();
         count += 1;
     }

@@ -6,7 +6,9 @@ mod common;
 
 use dermis::render::{render_scene, RenderOptions, RenderOutput};
 use dermis::scene::file::{load_scene, SceneFile};
+use dermis::scene::texture::LUMINANCE;
 use dermis::scene::Scene;
+use glam::Vec3;
 use std::path::Path;
 
 const SIZE: u32 = 128;
@@ -48,7 +50,7 @@ fn coverage(out: &RenderOutput) -> Coverage {
                 n += 1;
                 sx += x as f32;
                 sy += y as f32;
-                luma += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                luma += Vec3::from_slice(&p[..3]).dot(LUMINANCE);
             }
         }
     }
@@ -169,7 +171,7 @@ fn seam_gradients(mut file: SceneFile, distance_mm: f32) -> (usize, f32, f32) {
             return None;
         }
         let p = &img[((y as u32 * w + x as u32) * 4) as usize..][..3];
-        Some(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        Some(Vec3::from_slice(&p[..3]).dot(LUMINANCE))
     };
     // Seam edges: triangle edges whose positions recur elsewhere with other UVs.
     let mesh = &scene.mesh;
@@ -469,7 +471,7 @@ fn scattering_bleeds_red_into_the_shadow_edge() {
             render_scene(ctx, &scene, &opts).unwrap().hdr.unwrap()
         })
     });
-    let luma = |p: &[f32]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let luma = |p: &[f32]| Vec3::from_slice(&p[..3]).dot(LUMINANCE);
     let max = direct.chunks_exact(4).map(luma).fold(0.0f32, f32::max);
     let smax = skin.chunks_exact(4).map(luma).fold(0.0f32, f32::max);
     // Lit skin (direct above 30 % of its peak) against the shadow edge: pixels the

@@ -11,6 +11,7 @@ use dermis::graph::upload::Readback;
 use dermis::graph::{Access, Executor, Graph, Imported};
 use dermis::scene::file::Chain;
 use dermis::scene::mesh::Mesh;
+use dermis::scene::texture::LUMINANCE;
 use dermis::skin::blur::{BlurChain, BlurKernel};
 use dermis::skin::chain::{self, Stencil};
 use dermis::skin::profile::{gaussian, Kernel, Profile};
@@ -642,7 +643,7 @@ fn diffuse_term(set: impl Fn(&mut dermis::scene::file::Skin), direct: bool) -> V
 
 /// Mean |a − b| over the pixels both cover, relative to b's mean (luminance).
 fn mean_difference(a: &[f32], b: &[f32]) -> f64 {
-    let luma = |p: &[f32]| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64;
+    let luma = |p: &[f32]| f64::from(Vec3::from_slice(&p[..3]).dot(LUMINANCE));
     let (mut diff, mut sum) = (0.0, 0.0);
     for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         if p[3] > 0.5 && q[3] > 0.5 {

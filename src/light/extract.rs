@@ -43,6 +43,7 @@ use glam::{DVec3, Mat3, Vec3};
 
 use crate::scene::env::{texel_solid_angle_f64, EnvMap};
 pub use crate::scene::file::{LightsMode, MAX_EXTRACTED_LIGHTS};
+use crate::scene::texture::LUMINANCE;
 
 /// A core texel is this many times brighter than the map's median radiance.
 /// On the CC0 maps the sources peak at 2.6·10⁴ (studio's lamps, 110 over a
@@ -68,9 +69,6 @@ const HALO_FALLOFF_PER_DEG: f64 = 1.31;
 const MAX_HALO_DEG: f64 = 5.0;
 /// Upper bound on the fill's relaxation sweeps (the CC0 maps need 48–282).
 const MAX_FILL_SWEEPS: usize = 20_000;
-
-/// Rec. 709 / sRGB luminance weights.
-const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 
 /// A bright source taken out of the map.
 #[derive(Clone, Copy, Debug, PartialEq)]

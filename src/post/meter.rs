@@ -10,6 +10,7 @@
 use crate::error::Result;
 use crate::gpu::{Buffer, MemoryLocation, Pipeline, Pipelines, Sampler};
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle, Imported};
+use crate::scene::texture::LUMINANCE;
 use ash::vk;
 use std::sync::Arc;
 
@@ -18,9 +19,6 @@ pub const KEY: f32 = 0.18;
 /// δ of Reinhard et al.'s eq. 1, "a small value" that keeps black pixels'
 /// logarithm finite; 1e-4 is 11 stops under the key.
 pub const DELTA: f32 = 1e-4;
-/// Rec. 709 luminance weights (ITU-R BT.709-6, item 3.2), the primaries of the
-/// linear sRGB the renderer works in.
-pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 /// Alpha above which a pixel is the mesh's.
 pub const COVERED: f32 = 0.5;
 /// Bytes of the result: EV, L̄, pixels metered, 0 (f32 each).
@@ -71,7 +69,7 @@ impl Metered {
 pub fn exposure(rgba: &[f32]) -> Metered {
     let (mut sum, mut n) = (0.0f64, 0u64);
     for p in rgba.chunks_exact(4).filter(|p| p[3] > COVERED) {
-        let l = LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2];
+        let l = glam::Vec3::from_slice(&p[..3]).dot(LUMINANCE);
         sum += f64::from(DELTA + l.max(0.0)).ln();
         n += 1;
     }
@@ -165,7 +163,7 @@ impl Meter {
             .sample(hdr, &self.sampler)
             .write_buffer(&mut partials)
             .constants(&TilePush {
-                luminance: LUMINANCE,
+                luminance: LUMINANCE.to_array(),
                 delta: DELTA,
                 covered: COVERED,
             })

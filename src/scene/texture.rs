@@ -71,6 +71,10 @@ pub fn flip_rows<T>(pixels: &mut [T], row_len: usize) {
     }
 }
 
+/// Rec. 709 luminance weights (ITU-R BT.709-6, item 3.2): the primaries of the
+/// linear sRGB the renderer works in (IEC 61966-2-1).
+pub const LUMINANCE: glam::Vec3 = glam::Vec3::new(0.2126, 0.7152, 0.0722);
+
 /// IEC 61966-2-1 sRGB decoding of a value in [0, 1].
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {

@@ -21,6 +21,7 @@ use crate::render::output::{write_exr, write_rgba8_png};
 use crate::render::progress::Task;
 use crate::render::{render_scene, stored_images, RenderOptions, View};
 use crate::scene::file::{Chain, SceneFile};
+use crate::scene::texture::LUMINANCE;
 use crate::scene::Scene;
 use crate::skin::reference::{texels, Diffusion, MeshEdges, Texel};
 use crate::skin::specular::REGION_NAMES;
@@ -93,7 +94,7 @@ impl RegionRow {
         let rgba =
             |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|c| c.extend(1.0).to_array()).collect() };
         let got_rgba = rgba(got);
-        let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let lum = |c: Vec3| c.dot(LUMINANCE);
         let inside = upper
             .iter()
             .zip(lower)
@@ -602,7 +603,7 @@ fn texel_masks(
 /// Where scattering changes the light by more than SCATTERING_CHANGE: the
 /// reference's diffused luminance D against the irradiance's E, |D − E| > share · D.
 fn scattering_mask(diffused: &[Vec3], irradiance: &[Vec3]) -> (String, Vec<bool>) {
-    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let lum = |c: Vec3| c.dot(LUMINANCE);
     (
         format!("scattering > {:.0} %", 100.0 * SCATTERING_CHANGE),
         diffused

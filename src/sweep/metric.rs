@@ -5,6 +5,7 @@
 //! and per-pixel relative errors of luminance (mean, median, 90th percentile).
 
 use crate::error::{Error, Result};
+use crate::scene::texture::LUMINANCE;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -97,7 +98,9 @@ pub const RELATIVE_FLOOR: f64 = 0.1;
 
 /// Rec. 709 luminance of an RGBA pixel.
 fn luminance(p: &[f32]) -> f64 {
-    0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+    glam::Vec3::from_slice(&p[..3])
+        .as_dvec3()
+        .dot(LUMINANCE.as_dvec3())
 }
 
 /// [`RelativeError`] of `image` against `reference` (RGBA f32, same size) over `mask`.

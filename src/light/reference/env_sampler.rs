@@ -19,9 +19,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::scene::env::{direction_to_uv, texel_solid_angle_f64, EnvMap};
-
-/// Rec. 709 luminance weights.
-pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+use crate::scene::texture::LUMINANCE;
 
 /// The sampling distribution of one environment map.
 pub struct EnvSampler {

@@ -55,12 +55,13 @@ use std::f32::consts::PI;
 
 use glam::{DVec3, Vec2, Vec3};
 
-use super::env_sampler::{EnvSampler, LUMINANCE};
+use super::env_sampler::EnvSampler;
 use super::sequence::Rng;
 use crate::light::extract::{extract, LightsMode};
 use crate::light::occlusion::Bvh;
 use crate::scene::env::EnvMap;
 use crate::scene::mesh::Mesh;
+use crate::scene::texture::LUMINANCE;
 use crate::scene::{Light, LightSource};
 
 /// How long the estimator samples and where its rays start.

@@ -478,8 +478,7 @@ mod tests {
     }
 
     fn luminance(c: Vec3) -> f32 {
-        // Rec. 709 / sRGB luminance weights (IEC 61966-2-1).
-        0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+        c.dot(crate::scene::texture::LUMINANCE)
     }
 
     #[test]

@@ -264,7 +264,7 @@ mod tests {
         // Individual typology angle (Chardon et al. 1991): 28° < ITA ≤ 41° is
         // "intermediate" skin.
         let c = Palette::new().skin;
-        let y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        let y = c.dot(crate::scene::texture::LUMINANCE);
         let z = (0.0193 * c.x + 0.1192 * c.y + 0.9505 * c.z) / 1.089;
         let f = |t: f32| t.cbrt();
         let l_star = 116.0 * f(y) - 16.0;
