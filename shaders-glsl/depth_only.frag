@@ -7,12 +7,9 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_tangent;
-layout(location = 4) in vec3 v_t012;
-layout(location = 5) in vec3 v_t345;
-layout(location = 6) in vec3 v_t678;
-layout(location = 7) in vec3 v_s012;
-layout(location = 8) in vec3 v_s345;
-layout(location = 9) in vec3 v_s678;
-layout(location = 10) in vec3 v_indirect;
+layout(location = 4) in vec3 v_occluded;
+layout(location = 5) in vec3 v_s012;
+layout(location = 6) in vec3 v_s345;
+layout(location = 7) in vec3 v_s678;
 
 void main() {}

@@ -38,7 +38,7 @@ void main() {
     shading_dpdx = dFdx(v_position);
     shading_dpdy = dFdy(v_position);
     vec3 n = shading_normal();
-    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, vec2(0.0), 1.0);
+    vec3 e = irradiance_at(sh_transferred(lighting.sh, v_t012, v_t345, v_t678), v_position, v_normal, n, v_uv, vec2(0.0), 1.0);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     color = vec4(albedo / PI_F * e, 1.0);
 }

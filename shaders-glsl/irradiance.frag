@@ -18,13 +18,9 @@ layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
-layout(location = 4) in vec3 v_t012;
-layout(location = 5) in vec3 v_t345;
-layout(location = 6) in vec3 v_t678;
-// The light the skin reflects onto itself and the sky's through thin skin
-// (uv_lit.vert; lighting.glsl).
-layout(location = 7) in vec3 v_indirect;
-#define INDIRECT
+// The environment's irradiance through the transfer, plus the light the skin
+// reflects onto itself and the sky's through thin skin (uv_lit.vert).
+layout(location = 4) in vec3 v_occluded;
 #define SPEC_BECKMANN 5
 #define SPEC_ALBEDO 6
 #define SPEC_REGIONS 7
@@ -47,6 +43,6 @@ void main() {
     vec4 s = texelFetch(surface_normal_params, texel, 0);
     vec3 n = octahedral_decode(s.xy * 2.0 - 1.0);
     vec4 a = texelFetch(surface_albedo_mix, texel, 0);
-    vec3 e = irradiance_at(v_position, v_normal, n, v_uv, s.zw, a.a);
+    vec3 e = irradiance_at(v_occluded, v_position, v_normal, n, v_uv, s.zw, a.a);
     irradiance = vec4(e * a.rgb, 1.0);
 }

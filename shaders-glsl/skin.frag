@@ -69,16 +69,15 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) in vec4 v_tangent;
-layout(location = 4) in vec3 v_t012;
-layout(location = 5) in vec3 v_t345;
-layout(location = 6) in vec3 v_t678;
-layout(location = 7) in vec3 v_s012;
-layout(location = 8) in vec3 v_s345;
-layout(location = 9) in vec3 v_s678;
-layout(location = 10) in vec3 v_indirect;
+// The environment's irradiance through the transfer plus the light the skin
+// reflects onto itself and the sky's through thin skin (skin.vert), and the
+// lobe visibility's SH.
+layout(location = 4) in vec3 v_occluded;
+layout(location = 5) in vec3 v_s012;
+layout(location = 6) in vec3 v_s345;
+layout(location = 7) in vec3 v_s678;
 layout(location = 0) out vec4 color;
 #include "sh.glsl"
-#define INDIRECT
 #define ENERGY_CONSERVING
 #include "lighting.glsl"
 
@@ -114,7 +113,7 @@ void main() {
     // fetch above.
     if (PIXEL_LEVELS > 0u) {
         float env_share = max(1.0 - params.x * albedos.y, 0.0);
-        blurred += pc.pixel_weight.rgb * irradiance_at(v_position, v_normal, n, v_uv, params, env_share)
+        blurred += pc.pixel_weight.rgb * irradiance_at(v_occluded, v_position, v_normal, n, v_uv, params, env_share)
                  * pow(albedo, vec3(pc.mix_pre));
     }
     vec3 diffuse = UNBLURRED ? mix(lookup(irradiance), blurred, pc.blur_amount) : blurred;

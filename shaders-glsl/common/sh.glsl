@@ -12,3 +12,12 @@ vec3 sh_irradiance(vec4 L[9], vec3 n) {
          + 2.0 * C1 * (L[4].rgb * x * y + L[7].rgb * x * z + L[5].rgb * y * z)
          + 2.0 * C2 * (L[3].rgb * x + L[1].rgb * y + L[2].rgb * z);
 }
+
+// The irradiance of SH radiance sh through a transfer t (Yang et al.'s eq. 13:
+// E = Σ L_i·T_i; linear in t, so interpolating the transfer or the
+// irradiance between vertices gives the same).
+vec3 sh_transferred(vec4 sh[9], vec3 t012, vec3 t345, vec3 t678) {
+    return sh[0].rgb * t012.x + sh[1].rgb * t012.y + sh[2].rgb * t012.z
+         + sh[3].rgb * t345.x + sh[4].rgb * t345.y + sh[5].rgb * t345.z
+         + sh[6].rgb * t678.x + sh[7].rgb * t678.y + sh[8].rgb * t678.z;
+}
