@@ -1,6 +1,5 @@
 #version 460
-// mesh.vert plus, for the skin pass and its depth pre-pass (skin/shade.rs;
-// one vertex shader for both, so their depths are equal): the environment's
+// mesh.vert plus, for the skin pass (skin/shade.rs): the environment's
 // irradiance at the vertex through its SH transfer plus the light the skin
 // reflects onto it and the sky's through thin skin (common/indirect.glsl;
 // the final pass's unblurred levels, as uv_lit.vert has it for the
@@ -27,6 +26,8 @@ layout(location = 4) out vec3 v_occluded;
 layout(location = 5) out vec3 v_s012;
 layout(location = 6) out vec3 v_s345;
 layout(location = 7) out vec3 v_s678;
+// As skin_depth.vert's, so the pre-pass's depths are the final pass's.
+precise gl_Position;
 
 void main() {
     v_position = position;

@@ -633,7 +633,7 @@ impl Frame {
             &profile,
         );
         let size = (hdr.desc.width, hdr.desc.height);
-        let mut depth = p.shade.depth(g, inputs, (&light.shadows, &light.sh), size);
+        let mut depth = p.shade.depth(g, inputs, size);
         skybox::pass(
             g,
             &self.pipelines,

@@ -126,50 +126,43 @@ impl ShadePass {
         specialization.push(u32::from(transmission));
         specialization.push(u32::from(unblurred));
         specialization.push(pixel_levels as u32);
-        // The same vertex shader for both, so the shading pass's depth equals the
-        // pre-pass's exactly.
-        let mesh = |fragment, color_formats, depth_write| {
+        // The pre-pass transforms the position only; both vertex shaders
+        // compute gl_Position alike and `precise`, so the shading pass's depth
+        // equals the pre-pass's exactly.
+        let (stride, attributes) = Vertex::layout();
+        let mesh = |(vertex, fragment), vertex_layout, color_formats, depth_write| {
             pipelines.graphics(&GraphicsDesc {
-                vertex: "skin.vert",
+                vertex,
                 fragment,
                 color_formats,
                 depth_format: Some(DEPTH_FORMAT),
                 depth_write,
-                vertex_layout: Some(Vertex::layout()),
+                vertex_layout: Some(vertex_layout),
                 cull_mode: vk::CullModeFlags::NONE,
                 specialization: &specialization,
                 alpha_blend: false,
             })
         };
+        let skin = ("skin.vert", "skin.frag");
         Ok(Self {
-            depth: mesh("depth_only.frag", &[], true)?,
-            pipeline: mesh("skin.frag", &[HDR_FORMAT], false)?,
+            depth: mesh(
+                ("skin_depth.vert", "depth_only.frag"),
+                (stride, &attributes[..1]),
+                &[],
+                true,
+            )?,
+            pipeline: mesh(skin, (stride, attributes), &[HDR_FORMAT], false)?,
             pixel_levels,
         })
     }
 
     /// The depth pre-pass (`skin_depth`) at `(w, h)`: the mesh's depth, which
     /// the background and the final pass test against.
-    pub fn depth(
-        &self,
-        g: &mut Graph,
-        inputs: &FrameInputs,
-        (shadows, sh): (&ImageHandle, &BufferHandle),
-        (w, h): (u32, u32),
-    ) -> ImageHandle {
+    pub fn depth(&self, g: &mut Graph, inputs: &FrameInputs, (w, h): (u32, u32)) -> ImageHandle {
         let mut depth = g.create_image("depth", ImageDesc::new(w, h, DEPTH_FORMAT));
-        let s = &inputs.samplers;
-        // skin.vert's bindings (frame 0, transfer 4, SH 5, RGB transfer 6) in
-        // skin.frag's order.
         let pre = g
             .simple_pass("skin_depth", &self.depth)
             .uniform(&inputs.uniforms)
-            .texture(&inputs.albedo, &s.linear)
-            .texture(&inputs.normal, &s.linear)
-            .sample(shadows, &s.shadow)
-            .buffer(&inputs.transfer)
-            .read_uniform(sh)
-            .buffer(&inputs.rgb_transfer)
             .depth(&mut depth, LoadOp::Clear([1.0; 4]));
         inputs.mesh.draw(pre);
         depth
