@@ -12,8 +12,8 @@
 #define RGB_TRANSFER 6
 #include "transfer.glsl"
 layout(std140, binding = 5) uniform Lighting { vec4 sh[9]; } lighting;
-#include "indirect.glsl"
 #include "sh.glsl"
+#include "indirect.glsl"
 layout(location = 0) in vec3 position;   // mm
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
@@ -34,9 +34,7 @@ void main() {
     v_normal = normal;
     v_uv = uv;
     v_tangent = tangent;
-    vec3 t012, t345, t678;
-    load_transfer(t012, t345, t678);
-    v_occluded = sh_transferred(lighting.sh, t012, t345, t678) + indirect_irradiance(position);
+    v_occluded = occluded_irradiance(position);
     load_lobe_visibility(v_s012, v_s345, v_s678);
     gl_Position = frame.view_proj * vec4(position, 1.0);
 }

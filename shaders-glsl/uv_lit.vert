@@ -11,8 +11,8 @@
 #define RGB_TRANSFER 14
 #include "transfer.glsl"
 layout(std140, binding = 3) uniform Lighting { vec4 sh[9]; } lighting;
-#include "indirect.glsl"
 #include "sh.glsl"
+#include "indirect.glsl"
 layout(location = 0) in vec3 position;   // mm
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
@@ -26,8 +26,6 @@ void main() {
     v_position = position;
     v_normal = normal;
     v_uv = uv;
-    vec3 t012, t345, t678;
-    load_transfer(t012, t345, t678);
-    v_occluded = sh_transferred(lighting.sh, t012, t345, t678) + indirect_irradiance(position);
+    v_occluded = occluded_irradiance(position);
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
 }

@@ -22,3 +22,12 @@ vec3 indirect_irradiance(vec3 position) {
     }
     return rgb_transfer_irradiance(INTERREFLECTED, L) + through;
 }
+
+// lighting.glsl's `occluded` at this vertex, for the skin passes to
+// interpolate: the environment through the vertex's transfer (sh_transferred;
+// needs sh.glsl) plus indirect_irradiance.
+vec3 occluded_irradiance(vec3 position) {
+    vec3 t012, t345, t678;
+    load_transfer(t012, t345, t678);
+    return sh_transferred(lighting.sh, t012, t345, t678) + indirect_irradiance(position);
+}
