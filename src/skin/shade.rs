@@ -143,7 +143,6 @@ impl ShadePass {
                 alpha_blend: false,
             })
         };
-        let skin = ("skin.vert", "skin.frag");
         Ok(Self {
             depth: mesh(
                 ("skin_depth.vert", "depth_only.frag"),
@@ -151,7 +150,12 @@ impl ShadePass {
                 &[],
                 true,
             )?,
-            pipeline: mesh(skin, (stride, attributes), &[HDR_FORMAT], false)?,
+            pipeline: mesh(
+                ("skin.vert", "skin.frag"),
+                (stride, attributes),
+                &[HDR_FORMAT],
+                false,
+            )?,
             pixel_levels,
         })
     }
