@@ -32,6 +32,15 @@ impl Vertex {
     pub fn layout() -> (u32, &'static [(vk::Format, u32)]) {
         (std::mem::size_of::<Vertex>() as u32, &VERTEX_ATTRIBUTES)
     }
+
+    /// The position alone, for the depth-only passes (shadow maps, the
+    /// occlusion cube maps, the skin's depth pre-pass).
+    pub fn position_layout() -> (u32, &'static [(vk::Format, u32)]) {
+        (
+            std::mem::size_of::<Vertex>() as u32,
+            &VERTEX_ATTRIBUTES[..1],
+        )
+    }
 }
 
 pub struct MeshBuffers {

@@ -270,7 +270,7 @@ impl ShadowPass {
             depth_format: Some(SHADOW_FORMAT),
             depth_write: true,
             // Positions only.
-            vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
+            vertex_layout: Some(Vertex::position_layout()),
             cull_mode: vk::CullModeFlags::NONE,
             specialization: &[],
             alpha_blend: false,

@@ -129,7 +129,6 @@ impl ShadePass {
         // The pre-pass transforms the position only; both vertex shaders
         // compute gl_Position alike and `precise`, so the shading pass's depth
         // equals the pre-pass's exactly.
-        let (stride, attributes) = Vertex::layout();
         let mesh = |(vertex, fragment), vertex_layout, color_formats, depth_write| {
             pipelines.graphics(&GraphicsDesc {
                 vertex,
@@ -146,13 +145,13 @@ impl ShadePass {
         Ok(Self {
             depth: mesh(
                 ("skin_depth.vert", "depth_only.frag"),
-                (stride, &attributes[..1]),
+                Vertex::position_layout(),
                 &[],
                 true,
             )?,
             pipeline: mesh(
                 ("skin.vert", "skin.frag"),
-                (stride, attributes),
+                Vertex::layout(),
                 &[HDR_FORMAT],
                 false,
             )?,

@@ -125,7 +125,7 @@ pub fn raster_vertices(
             depth_format: None,
             depth_write: true,
             // Positions only.
-            vertex_layout: Some((Vertex::layout().0, &Vertex::layout().1[..1])),
+            vertex_layout: Some(Vertex::position_layout()),
             cull_mode: vk::CullModeFlags::NONE,
             specialization: &[],
             alpha_blend: false,
