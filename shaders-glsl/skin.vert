@@ -2,8 +2,8 @@
 // mesh.vert plus, for the skin pass (skin/shade.rs): the environment's
 // irradiance at the vertex through its SH transfer plus the light the skin
 // reflects onto it and the sky's through thin skin (common/indirect.glsl;
-// the final pass's unblurred levels, as uv_lit.vert has it for the
-// irradiance pass), and the vertex's lobe visibility (light/occlusion/lobe.rs).
+// the final pass's unblurred levels, as uv_lit.vert and irradiance_vertices.comp
+// have it for the irradiance pass), and the vertex's lobe visibility (light/occlusion/lobe.rs).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "frame.glsl"

@@ -15,7 +15,7 @@ use dermis::light::prefilter;
 use dermis::render::{render_scene, RenderOptions, View};
 use dermis::scene::camera::Camera;
 use dermis::scene::env::{self as envmap, EnvMap};
-use dermis::scene::file::{LightsMode, Occlusion, SceneFile};
+use dermis::scene::file::{IrradianceShading, LightsMode, Occlusion, SceneFile};
 use dermis::scene::mesh::Mesh;
 use dermis::scene::texture::{Encoding, Texture};
 use dermis::scene::{Light, LightSource, Scene};
@@ -440,22 +440,26 @@ fn soft_shadows_follow_the_source_size() {
     );
 }
 
+/// A(cos θ, m) by the CPU quadrature at 257 angles, interpolated linearly: A
+/// is smooth in cos θ, and the quadrature is too slow to call per texel.
+fn specular_albedo_table() -> impl Fn(f32) -> f32 {
+    let table: Vec<f32> = (0..=256)
+        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M))
+        .collect();
+    move |c: f32| {
+        let x = c.clamp(0.0, 1.0) * 256.0;
+        let i = (x as usize).min(255);
+        table[i] + (table[i + 1] - table[i]) * (x - i as f32)
+    }
+}
+
 #[test]
 fn shadow_maps_shadow_the_texture_space_irradiance() {
     let s = ShadowScene::new();
     let img = render(&s.scene, View::named("irradiance"));
     let res = s.scene.file.render.irradiance_resolution as usize;
     let mix = s.scene.file.skin.mix;
-    // A(cos θ, m) by the CPU quadrature at 257 angles, interpolated linearly: A
-    // is smooth in cos θ, and the quadrature is too slow to call per texel.
-    let table: Vec<f32> = (0..=256)
-        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M))
-        .collect();
-    let albedo = |c: f32| {
-        let x = c.clamp(0.0, 1.0) * 256.0;
-        let i = (x as usize).min(255);
-        table[i] + (table[i + 1] - table[i]) * (x - i as f32)
-    };
+    let albedo = specular_albedo_table();
     // The big sphere covers the left half of the texture.
     let mut points = Vec::new();
     let expected: Vec<Option<f32>> = (0..res * res)
@@ -481,6 +485,73 @@ fn shadow_maps_shadow_the_texture_space_irradiance() {
         n > 10_000 && in_shadow > 500,
         "{n} texels, {in_shadow} shadowed"
     );
+}
+
+/// Both formulations of the irradiance pass (`render.irradiance_shading`: the
+/// mesh rasterised by its UVs every frame, or a compute pass over a texel map
+/// and per-vertex values) light each texel at the point a raster of the mesh by
+/// its UVs puts there: a coarse sphere near an unshadowed point light, whose
+/// light changes across a triangle, against the same mesh rasterised by its UVs
+/// on the CPU (barycentric weights at each texel's centre, the position and
+/// normal interpolated).
+#[test]
+fn the_irradiance_texture_lights_the_point_its_uv_raster_holds() {
+    for shading in [IrradianceShading::Raster, IrradianceShading::Compute] {
+        irradiance_at_the_uv_raster(shading);
+    }
+}
+
+fn irradiance_at_the_uv_raster(shading: IrradianceShading) {
+    let light = Light {
+        source: LightSource::Point(Vec3::new(0.0, 20.0, R + 25.0)),
+        irradiance: Vec3::splat(0.01),
+        shadow: false,
+        angular_radius: 0.0,
+    };
+    let mesh = sphere(Vec3::ZERO, R, 24, 12, (0.0, 1.0));
+    let mut s = scene(mesh, vec![light], EnvMap::uniform(Vec3::ZERO, 64, 32));
+    s.file.render.irradiance_shading = shading;
+    let img = render(&s, View::named("irradiance"));
+    let res = s.file.render.irradiance_resolution as usize;
+    let (albedo, mix) = (specular_albedo_table(), s.file.skin.mix);
+    let m = &s.mesh;
+    let mut expected = vec![None; res * res];
+    for t in m.indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| t[k] as usize);
+        let uv = [a, b, c].map(|v| m.uvs[v] * res as f32);
+        let area = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+        if area.abs() < 1e-9 {
+            continue;
+        }
+        let lo = uv[0].min(uv[1]).min(uv[2]).floor().max(Vec2::ZERO);
+        let hi = uv[0]
+            .max(uv[1])
+            .max(uv[2])
+            .ceil()
+            .min(Vec2::splat(res as f32));
+        for y in lo.y as usize..hi.y as usize {
+            for x in lo.x as usize..hi.x as usize {
+                let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let w = [(1, 2), (2, 0), (0, 1)]
+                    .map(|(i, j)| (uv[j] - uv[i]).perp_dot(q - uv[i]) / area);
+                if w.iter().any(|&w| w < 1e-4) {
+                    continue; // on or near an edge: either triangle's raster
+                }
+                let p = m.positions[a] * w[0] + m.positions[b] * w[1] + m.positions[c] * w[2];
+                let n =
+                    (m.normals[a] * w[0] + m.normals[b] * w[1] + m.normals[c] * w[2]).normalize();
+                let (l, e) = light.at(p);
+                let cos = n.dot(l);
+                // Away from the terminator, where the flat normal map's 8-bit
+                // tilt (0.4 %) is a large share of N·L.
+                expected[y * res + x] = (cos >= 0.5)
+                    .then(|| e.x * cos * (1.0 - rho_s() * albedo(cos)) * ALBEDO.powf(mix));
+            }
+        }
+    }
+    let what = format!("{shading:?}: irradiance at the UV raster's points");
+    let (n, _) = compare(&what, |i| img[i * 4], &expected);
+    assert!(n > 5_000, "{n} texels");
 }
 
 #[test]

@@ -17,6 +17,12 @@
 layout(binding = SHADOW_ATLAS) uniform sampler2DShadow shadow_atlas;
 #include "incident.glsl"
 
+// The shaded sample's window position (a compute pass over a UV map defines
+// it as its texel's centre).
+#ifndef SHADING_POINT
+#define SHADING_POINT gl_FragCoord.xy
+#endif
+
 // The shaded point's position derivatives across its pixel (or, over a UV
 // raster, its texel): dFdx/dFdy of the position, taken by the fragment shader
 // in uniform control flow before any lookup. A point or directional source
@@ -38,7 +44,7 @@ const float MAX_SOFT_TEXELS = 48.0;
 
 // A per-pixel rotation by interleaved gradient noise (Jimenez 2014).
 mat2 soft_shadow_turn() {
-    float a = 6.2831853 * fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+    float a = 6.2831853 * fract(52.9829189 * fract(dot(SHADING_POINT, vec2(0.06711056, 0.00583715))));
     float c = cos(a), s = sin(a);
     return mat2(c, s, -s, c);
 }
@@ -265,11 +271,11 @@ layout(binding = HARD_VISIBILITY) uniform sampler2D hard_visibility0;
 layout(binding = HARD_VISIBILITY + 1) uniform sampler2D hard_visibility1;
 layout(binding = HARD_VISIBILITY + 2) uniform sampler2D hard_visibility2;
 
-// Hard light i's visibility at this fragment, as light_visibility.frag (HARD)
+// Hard light i's visibility at this sample, as light_visibility.frag (HARD)
 // stored it over the same UV raster at the same resolution: texel for texel.
 float stored_hard_visibility(int i) {
     int slot = bitCount(SHADOWED_LIGHTS & ~SOFT_LIGHTS & ((1 << i) - 1));
-    ivec2 p = ivec2(gl_FragCoord.xy);
+    ivec2 p = ivec2(SHADING_POINT);
     vec4 t = slot < 3 ? texelFetch(hard_visibility0, p, 0)
            : slot < 6 ? texelFetch(hard_visibility1, p, 0)
                       : texelFetch(hard_visibility2, p, 0);

@@ -47,6 +47,7 @@ pub struct MeshBuffers {
     pub vertices: Arc<Buffer>,
     pub indices: Arc<Buffer>,
     pub index_count: u32,
+    pub vertex_count: u32,
 }
 
 impl MeshBuffers {
@@ -75,6 +76,7 @@ impl MeshBuffers {
                 Access::IndexBuffer,
             )?,
             index_count: mesh.indices.len() as u32,
+            vertex_count: vertices.len() as u32,
         })
     }
 

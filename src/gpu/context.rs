@@ -55,6 +55,13 @@ pub struct DeviceInfo {
     pub validation: bool,
 }
 
+impl DeviceInfo {
+    /// A CPU implementation (lavapipe): work runs on the host's cores.
+    pub fn is_cpu(&self) -> bool {
+        self.device_type == "CPU"
+    }
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct MemoryHeap {
     pub size_bytes: u64,

@@ -227,8 +227,10 @@ impl Access {
             | Access::ComputeBufferWrite
             | Access::FragmentBufferRead
             | Access::ShaderBufferRead => U::STORAGE_BUFFER,
-            Access::VertexBuffer => U::VERTEX_BUFFER,
-            Access::IndexBuffer => U::INDEX_BUFFER,
+            // A pass may also fetch the triangles itself (a static storage
+            // buffer: skin::irradiance's texel map).
+            Access::VertexBuffer => U::VERTEX_BUFFER | U::STORAGE_BUFFER,
+            Access::IndexBuffer => U::INDEX_BUFFER | U::STORAGE_BUFFER,
             Access::UniformRead => U::UNIFORM_BUFFER,
             Access::TransferSrc => U::TRANSFER_SRC,
             Access::TransferDst => U::TRANSFER_DST,

@@ -23,7 +23,7 @@
 //! (docs/skin.md) and reflects it itself, so `ρ`, the albedo map, stands for
 //! both within ρs·Ā·(1 − ρ) ≈ 2 % of the hit's light. The GPU applies `B` to the
 //! environment's SH and to the explicit lights projected into SH at the
-//! receiving vertex (`uv_lit.vert`), so a lamp's light bounces as if the
+//! receiving vertex (`uv_lit.vert`, `irradiance_vertices.comp`), so a lamp's light bounces as if the
 //! hit's own occlusion shadowed it: second-order light, low in frequency.
 
 use std::sync::atomic::{AtomicUsize, Ordering};

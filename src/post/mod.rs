@@ -109,6 +109,7 @@ impl PostSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::file::IrradianceShading;
 
     #[test]
     fn clear_takes_out_exactly_what_resolve_reads() {
@@ -119,6 +120,7 @@ mod tests {
             irradiance_resolution: 512,
             shadow_resolution: 256,
             shadow_focus: false,
+            irradiance_shading: IrradianceShading::Compute,
             exposure: Some(1.5),
             gamma: Gamma::Power(1.8),
             tone_curve: ToneCurve::Aces,
@@ -142,6 +144,7 @@ mod tests {
             (r.irradiance_resolution, r.shadow_resolution)
         );
         assert_eq!(cleared.shadow_focus, r.shadow_focus);
+        assert_eq!(cleared.irradiance_shading, r.irradiance_shading);
         assert_ne!(
             (d.width, d.irradiance_resolution, d.shadow_resolution),
             (r.width, r.irradiance_resolution, r.shadow_resolution)

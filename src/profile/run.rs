@@ -57,6 +57,11 @@ pub struct RunSetup {
     /// A second shadow map per shadowed light, fitted to what the camera sees
     /// (`render.shadow_focus`; false in reports written before it existed).
     pub shadow_focus: bool,
+    /// How the irradiance pass reached the texels (`render.irradiance_shading`
+    /// as run): `compute`, or absent for `raster` (as in reports written
+    /// before the compute pass existed).
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub irradiance_shading: String,
     /// The scene's explicit lights.
     pub lights: usize,
     /// `environment.lights`: `auto` or a count.

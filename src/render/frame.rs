@@ -284,7 +284,7 @@ impl Passes {
                 constant_stretch,
                 skin.shear_correction,
             )?,
-            irradiance: IrradiancePass::new(p, variant, res)?,
+            irradiance: IrradiancePass::new(p, variant, res, scene.file.render.irradiance_shading)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
             shade: ShadePass::new(
                 p,

@@ -83,7 +83,7 @@ impl RenderOptions {
         let ms = match (self.frames, self.warmup_ms) {
             (0..=1, _) => 0,
             (_, Some(ms)) => ms,
-            _ if device.device_type == "CPU" => 0,
+            _ if device.is_cpu() => 0,
             _ => PREROLL_GPU_MS,
         };
         std::time::Duration::from_millis(ms.into())
@@ -110,7 +110,7 @@ impl Default for RenderOptions {
 /// given).
 fn setup(
     scene: &Scene,
-    opts: &RenderOptions,
+    (opts, device): (&RenderOptions, &DeviceInfo),
     view: &View,
     extracted_lights: usize,
     (exposure_ev, exposure_metered): (f32, bool),
@@ -147,6 +147,10 @@ fn setup(
         .into(),
         shadow_resolution: f.render.shadow_resolution,
         shadow_focus: f.render.shadow_focus,
+        irradiance_shading: match f.render.irradiance_shading.compute(device.is_cpu()) {
+            true => "compute".into(),
+            false => String::new(),
+        },
         lights: f.lights.len(),
         environment_lights: f.environment.lights.to_string(),
         extracted_lights,
@@ -504,7 +508,7 @@ fn run(
     };
     let run_setup = setup(
         scene,
-        opts,
+        (opts, &ctx.info),
         view,
         frame.extracted_lights(),
         (ev, metered.is_some()),
@@ -544,7 +548,7 @@ fn reference(ctx: &Arc<Context>, scene: &Scene, opts: &RenderOptions) -> Result<
     let rgba = std::mem::take(&mut image.rgba);
     let hdr = opts.hdr.then_some(rgba);
     let view = View::Screen(Screen::Reference);
-    let setup = setup(scene, opts, &view, 0, (ev, metered.is_some()));
+    let setup = setup(scene, (opts, &ctx.info), &view, 0, (ev, metered.is_some()));
     Ok(RenderOutput {
         width: w,
         height: h,

@@ -7,7 +7,8 @@ use std::path::PathBuf;
 
 use super::env::EnvSource;
 use super::file::{
-    self, parse_env_source, Chain, Kernel, LightsMode, Occlusion, SceneFile, ToneCurve, UvOrigin,
+    self, parse_env_source, Chain, IrradianceShading, Kernel, LightsMode, Occlusion, SceneFile,
+    ToneCurve, UvOrigin,
 };
 use crate::error::Result;
 
@@ -167,6 +168,12 @@ overrides! {
     shadow_focus: bool => render.shadow_focus, example "off";
     /// Side of the UV-space irradiance texture (power of two, 256..8192).
     irradiance_res: u32 => render.irradiance_resolution, example "512";
+    /// How the irradiance pass reaches the texels, replacing
+    /// `render.irradiance_shading`: `raster` (the mesh by its UVs every frame),
+    /// `compute` (a pass over a texel map drawn once per render) or `auto`
+    /// (raster on a CPU device, compute on a GPU).
+    #[arg(value_enum)]
+    irradiance_shading: IrradianceShading => render.irradiance_shading, example "compute";
     /// Per-vertex occlusion (default: the scene's, raytrace).
     #[arg(value_enum)]
     occlusion: Occlusion => skin.occlusion, example "raster";

@@ -26,7 +26,7 @@ pub use environment::{
 };
 use error::one_line;
 pub use error::SceneError;
-pub use render::{Gamma, Render, ToneCurve, MAX_RENDER_SIZE};
+pub use render::{Gamma, IrradianceShading, Render, ToneCurve, MAX_RENDER_SIZE};
 pub use skin::{
     Chain, Kernel, Occlusion, ProfileGaussian, Skin, SpecularRegion, MAX_BLUR_WIDTH,
     PROFILE_SUM_TOLERANCE, REGION_COUNT,

@@ -58,6 +58,31 @@ impl<'de> Deserialize<'de> for Gamma {
     }
 }
 
+/// How the irradiance pass reaches the texels of the UV layout
+/// (skin::irradiance; docs/performance.md, "The irradiance pass in compute").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IrradianceShading {
+    /// `raster` on a CPU device (lavapipe), `compute` on a GPU: the faster of
+    /// the two where each was measured.
+    Auto,
+    /// The mesh rasterised by its UVs every frame.
+    Raster,
+    /// A compute pass over a texel map rasterised once per render.
+    Compute,
+}
+
+impl IrradianceShading {
+    /// Whether the compute pass runs, on a CPU device or not.
+    pub fn compute(self, cpu_device: bool) -> bool {
+        match self {
+            IrradianceShading::Auto => !cpu_device,
+            IrradianceShading::Raster => false,
+            IrradianceShading::Compute => true,
+        }
+    }
+}
+
 /// Output image and internal resolution.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -71,6 +96,8 @@ pub struct Render {
     /// A second map per shadowed light, fitted to what the camera sees
     /// (light::shadow::Focus).
     pub shadow_focus: bool,
+    /// How the irradiance pass reaches the texels (skin::irradiance).
+    pub irradiance_shading: IrradianceShading,
     /// Exposure in EV (stops): output = radiance × 2^exposure. `None`: metered
     /// from the rendered frame (post::meter).
     pub exposure: Option<f32>,
@@ -96,6 +123,7 @@ impl Default for Render {
             irradiance_resolution: 4096,
             shadow_resolution: 2048,
             shadow_focus: true,
+            irradiance_shading: IrradianceShading::Auto,
             exposure: None,
             gamma: Gamma::Srgb,
             tone_curve: ToneCurve::Linear,
