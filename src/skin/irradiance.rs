@@ -5,8 +5,8 @@
 //! render; issue 24, docs/performance.md):
 //! - `surface`: the normal-mapped shading normal, albedo^mix, the specular's
 //!   (ρs, m) and the share of the environment's light it lets in, 1 − ρs·Ā(m);
-//! - `texel_map`: per texel the covering triangle's three vertices and its
-//!   weights on them (texel_map.vert).
+//! - `texel_map`, for the compute formulation below: per texel the covering
+//!   triangle's three vertices and its weights on them (texel_map.vert).
 //!
 //! Each frame lights every covered texel, one of two ways
 //! (`render.irradiance_shading`; docs/performance.md, "The irradiance pass in
