@@ -1,7 +1,8 @@
 #!/bin/bash
 # The real-GPU measurements of docs/performance.md ("On a real GPU"): per-pass
 # GPU timestamps of the default scene and the lit close-up, an interleaved
-# comparison with a base build, and both sweeps. Run from the repository root:
+# comparison with a base build, the irradiance pass's raster and compute
+# formulations side by side, and both sweeps. Run from the repository root:
 #
 #   DERMIS=target/release/dermis BASE=old/dermis OUT=gpu docs/recipes/gpu-measure.sh
 #
@@ -40,6 +41,14 @@ if [ -n "${BASE:-}" ]; then
             --out-dir "$OUT/il/il-$res"
     done
 fi
+# The irradiance pass's two formulations side by side (`auto` runs compute on
+# a GPU; docs/performance.md, "The irradiance pass in compute").
+for res in 1024 4096; do
+    step 300 "$DERMIS" interleave --runs "$RUNS" --frames "$FRAMES" --allow-setup-change \
+        --base-args "--irradiance-res $res --irradiance-shading raster" \
+        --new-args "--irradiance-res $res --irradiance-shading compute" \
+        --out-dir "$OUT/il/shading-$res"
+done
 step 600 "$DERMIS" sweep --resolutions 256,512,1024,2048,4096,8192 --frames 20 \
     --reference-resolution 4096 --out-dir "$OUT/sweep-default"
 step 600 "$DERMIS" sweep --scene docs/scenes/close-up-lights.toml \
