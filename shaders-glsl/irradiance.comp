@@ -38,7 +38,7 @@ vec2 shading_point;
 #define ENERGY_CONSERVING
 #include "lighting.glsl"
 layout(binding = 18, rgba16f) uniform writeonly image2D irradiance;
-const uint VERTICES_PER_ROW = 1024u;   // skin::irradiance::VERTICES_PER_ROW
+#include "vertices.glsl"
 
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
@@ -53,8 +53,7 @@ void main() {
     vec3 w = vec3(1.0 - w12.x - w12.y, w12);
     vec3 x = vec3(0.0), occluded = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k) {
-        uint v = t[k] - 1u;
-        ivec2 at = ivec2(2u * (v % VERTICES_PER_ROW), v / VERTICES_PER_ROW);
+        ivec2 at = vertex_values_texel(t[k] - 1u);
         x += w[k] * texelFetch(vertex_values, at, 0).xyz;
         occluded += w[k] * texelFetch(vertex_values, at + ivec2(1, 0), 0).xyz;
     }

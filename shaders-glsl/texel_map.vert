@@ -3,11 +3,10 @@
 // by its UVs as uv.vert does, but without a vertex buffer, corner by corner
 // (gl_VertexIndex runs over the index buffer), so that each fragment gets its
 // triangle's three vertices (flat) and its weight on each (interpolated).
+#extension GL_GOOGLE_include_directive : require
 layout(std430, binding = 0) readonly buffer Indices { uint indices[]; };
-// frame::Vertex: position, normal, uv, tangent, 12 floats.
-layout(std430, binding = 1) readonly buffer Vertices { float vertices[]; };
-const uint VERTEX_FLOATS = 12u;
-const uint UV_FLOAT = 6u;
+#define VERTICES 1
+#include "vertices.glsl"
 layout(location = 0) out vec3 v_weights;
 layout(location = 1) flat out uvec3 v_corners;
 

@@ -19,6 +19,14 @@ pub struct Vertex {
     pub tangent: [f32; 4],
 }
 
+// Shaders that read the vertex buffer as storage count 12 floats a vertex,
+// the position at float 0 and the uv at float 6 (common/vertices.glsl).
+const _: () = assert!(
+    std::mem::size_of::<Vertex>() == 12 * 4
+        && std::mem::offset_of!(Vertex, position) == 0
+        && std::mem::offset_of!(Vertex, uv) == 6 * 4
+);
+
 /// The vertex layout the mesh pipelines declare: (format, offset) per location.
 pub const VERTEX_ATTRIBUTES: [(vk::Format, u32); 4] = [
     (vk::Format::R32G32B32_SFLOAT, 0),

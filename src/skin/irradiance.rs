@@ -38,7 +38,7 @@ const SURFACE_FORMAT: vk::Format = vk::Format::R16G16B16A16_UNORM;
 /// gutter) and two 16-bit weights.
 const TEXEL_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
 /// Vertices per row of the per-frame vertex values, two texels each
-/// (irradiance_vertices.comp, irradiance.comp).
+/// (common/vertices.glsl).
 const VERTICES_PER_ROW: u32 = 1024;
 
 pub struct IrradiancePass {
@@ -81,17 +81,12 @@ impl IrradiancePass {
             .then(|| -> Result<TexelMap> {
                 Ok(TexelMap {
                     image: image("texel_map", TEXEL_MAP_FORMAT)?,
+                    // The full-screen state: no vertex input, no depth, no
+                    // culling (UV charts may be mirrored: both windings are
+                    // surface); the vertices are the mesh's corners.
                     pipeline: pipelines.graphics(&GraphicsDesc {
                         vertex: "texel_map.vert",
-                        fragment: "texel_map.frag",
-                        color_formats: &[TEXEL_MAP_FORMAT],
-                        depth_format: None,
-                        depth_write: false,
-                        vertex_layout: None,
-                        // UV charts may be mirrored: both windings are surface.
-                        cull_mode: vk::CullModeFlags::NONE,
-                        specialization: &[],
-                        alpha_blend: false,
+                        ..GraphicsDesc::fullscreen("texel_map.frag", &[TEXEL_MAP_FORMAT])
                     })?,
                     vertices_pipeline: pipelines
                         .compute("irradiance_vertices.comp", &specialization)?,
