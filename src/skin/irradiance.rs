@@ -160,9 +160,9 @@ impl IrradiancePass {
             .sample(&normal, &s.nearest)
             .sample(&albedo, &s.nearest)
             .read_uniform(sh);
+        let lit = (shadows, soft, hard);
         let Some((texel_map, values)) = map else {
             let pass = pass.buffer(&inputs.transfer);
-            let lit = (shadows, soft, hard);
             let pass = lights(tables.bind(pass, inputs), lit, s, |p| {
                 p.buffer(&inputs.rgb_transfer)
             });
@@ -172,7 +172,7 @@ impl IrradiancePass {
             return out;
         };
         let pass = pass.sample(&texel_map, &s.nearest);
-        let pass = lights(tables.bind(pass, inputs), (shadows, soft, hard), s, |p| {
+        let pass = lights(tables.bind(pass, inputs), lit, s, |p| {
             p.sample(&values, &s.nearest)
         });
         pass.store(&mut out).dispatch([side, side, 1]);

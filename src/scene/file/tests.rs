@@ -129,6 +129,7 @@ profile = [
 width = 640
 height = 480
 irradiance_resolution = 1024
+irradiance_shading = "compute"
 exposure = -1.5
 gamma = 2.2
 tone_curve = "neutral"
@@ -165,6 +166,7 @@ glow_intensity = 0.5
     assert_eq!(s.render.gamma, Gamma::Power(2.2));
     assert_eq!(s.render.exposure, Some(-1.5));
     assert_eq!(s.render.tone_curve, ToneCurve::Neutral);
+    assert_eq!(s.render.irradiance_shading, IrradianceShading::Compute);
     assert!(!s.render.skybox && s.render.glow);
     assert_eq!(s.render.background, [0.1, 0.2, 0.3]);
     assert_eq!(s.render.glow_intensity, 0.5);
@@ -342,6 +344,11 @@ fn syntax_and_type_errors_have_positions() {
             "[render]\ntone_curve = \"sepia\"",
             2,
             "unknown variant `sepia`",
+        ),
+        (
+            "[render]\nirradiance_shading = \"gpu\"",
+            2,
+            "unknown variant `gpu`, expected one of `auto`, `raster`, `compute`",
         ),
         ("[render]\nglow = \"yes\"", 2, "invalid type"),
         ("[camera]\nposition = [1, 2]", 2, ""),
