@@ -156,6 +156,60 @@ fn the_debug_sheet_and_the_occlusion_comparison_are_labelled_images_of_their_vie
         .any(|p| p[0] > 200));
 }
 
+/// The sky is drawn behind the shaded images only: a term's view (diffuse,
+/// specular, the light through thin skin) or a fraction (occlusion) shows the
+/// term alone, so its exposure, metered on the term, cannot blow the sky out.
+#[test]
+fn the_sky_is_behind_the_shaded_views_only() {
+    let scene = scene();
+    assert!(
+        scene.file.render.skybox,
+        "the test needs a scene with its sky on"
+    );
+    let outs = common::with_gpu(|ctx| {
+        [
+            "final",
+            "direct",
+            "diffuse",
+            "specular",
+            "transmission",
+            "occlusion",
+        ]
+        .map(|name| {
+            let opts = RenderOptions {
+                view: View::named(name),
+                hdr: true,
+                ..RenderOptions::default()
+            };
+            (name, render_scene(ctx, &scene, &opts).unwrap())
+        })
+    });
+    for (name, out) in outs {
+        let hdr = out.hdr.as_ref().unwrap();
+        // Uncovered pixels (alpha 0) and the brightest of them.
+        let sky = hdr
+            .chunks_exact(4)
+            .filter(|p| p[3] == 0.0)
+            .map(|p| p[0].max(p[1]).max(p[2]))
+            .collect::<Vec<f32>>();
+        let brightest = sky.iter().fold(0.0f32, |a, &b| a.max(b));
+        println!(
+            "{name:>12}: {} uncovered pixels, brightest {brightest}",
+            sky.len()
+        );
+        assert!(
+            sky.len() > (SIZE.0 * SIZE.1 / 10) as usize,
+            "{name}: {}",
+            sky.len()
+        );
+        if matches!(name, "final" | "direct") {
+            assert!(brightest > 0.0, "{name}: no sky");
+        } else {
+            assert_eq!(brightest, 0.0, "{name}: the sky is drawn behind a term");
+        }
+    }
+}
+
 /// Texels of an `n`² grid whose centre lies in a UV triangle of `mesh`, with
 /// row 0 at v = 1 (`authored`: the orientation of a bottom-left map's image)
 /// or at v = 0.

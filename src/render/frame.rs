@@ -14,7 +14,7 @@ use crate::frame::{
 use crate::gpu::{Context, ImageDesc, Pipelines};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle};
-use crate::light::direct::DirectPass;
+use crate::light::direct::{DirectPass, DirectView};
 use crate::light::extract::extract;
 use crate::light::interreflection;
 use crate::light::lighting::Lighting;
@@ -575,7 +575,9 @@ impl Frame {
             // The frame was made with the checker as its albedo.
             Screen::TestTexture => self.skin(g, ShadeMode::Full, light, &mut hdr)?,
             Screen::Direct(view) => {
-                skybox::pass(g, &self.pipelines, inputs, &mut hdr, self.post.skybox, None)?;
+                // The sky belongs behind the shaded image, not behind a fraction.
+                let sky = self.post.skybox && view == DirectView::Shading;
+                skybox::pass(g, &self.pipelines, inputs, &mut hdr, sky, None)?;
                 let (sh, shadows, soft) = (&light.sh, &light.shadows, &light.soft);
                 p.direct.pass(g, view, inputs, sh, shadows, soft, &mut hdr);
             }
@@ -634,14 +636,10 @@ impl Frame {
         );
         let size = (hdr.desc.width, hdr.desc.height);
         let mut depth = p.shade.depth(g, inputs, size);
-        skybox::pass(
-            g,
-            &self.pipelines,
-            inputs,
-            hdr,
-            self.post.skybox,
-            Some(&mut depth),
-        )?;
+        // A term's view shows the term alone: metered on a dim term (the light
+        // through thin skin, the specular) the sky would be blown out.
+        let sky = self.post.skybox && mode == ShadeMode::Full;
+        skybox::pass(g, &self.pipelines, inputs, hdr, sky, Some(&mut depth))?;
         let settings = ShadeSettings {
             weights: self.weights,
             transmission: self.skin.transmission,
