@@ -128,6 +128,13 @@ def parse_args(argv):
         "linear albedo (no maps; specular at the map's mean), seen from above",
     )
     p.add_argument(
+        "--slab-thickness",
+        type=float,
+        default=100.0,
+        help="with --slab: its thickness in mm (with --sun 0,1,0:E and --sky 0, the "
+        "light it transmits; docs/skin.md, \"Transmission against the walk\")",
+    )
+    p.add_argument(
         "--slab-mu",
         type=float,
         default=1.0,
@@ -206,6 +213,8 @@ def parse_args(argv):
             p.error("--slab takes three numbers R,G,B")
         if len(args.slab) != 3 or not all(0.0 <= c <= 1.0 for c in args.slab):
             p.error("--slab takes three numbers in [0, 1]")
+    if not args.slab_thickness > 0.0:
+        p.error("--slab-thickness must be > 0")
     if not 0.0 < args.slab_mu <= 1.0:
         p.error("--slab-mu must be in (0, 1]")
     for name in ("width", "height", "samples", "threads"):
@@ -381,11 +390,12 @@ def world(args):
     return w
 
 
-def slab():
-    """A 1 m x 1 m x 100 mm box, top face at z = 0 (Blender units)."""
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, -50.0 / MM_PER_UNIT))
+def slab(thickness_mm):
+    """A 1 m x 1 m box this thick, top face at z = 0 (Blender units)."""
+    z = -0.5 * thickness_mm / MM_PER_UNIT
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 0.0, z))
     box = bpy.context.active_object
-    box.scale = (1000.0 / MM_PER_UNIT, 1000.0 / MM_PER_UNIT, 100.0 / MM_PER_UNIT)
+    box.scale = (1000.0 / MM_PER_UNIT, 1000.0 / MM_PER_UNIT, thickness_mm / MM_PER_UNIT)
     return box
 
 
@@ -434,7 +444,7 @@ def main():
     scene = bpy.context.scene
     if args.slab_reflectance:
         args.slab, args.specular, args.sss = (0.5, 0.5, 0.5), "off", "on"
-    head = slab() if args.slab else import_head()
+    head = slab(args.slab_thickness) if args.slab else import_head()
     head.data.materials.clear()
     head.data.materials.append(skin_material(args))
     if args.occlusion == "off":
