@@ -135,6 +135,13 @@ def parse_args(argv):
         "light it transmits; docs/skin.md, \"Transmission against the walk\")",
     )
     p.add_argument(
+        "--slab-edge",
+        action="store_true",
+        help="with --slab: a half plane 3 mm above it, hidden from the camera, "
+        "shadows x < 0, and the camera sees 24 mm across the edge (the light "
+        "the walk carries into the shadow; docs/skin.md)",
+    )
+    p.add_argument(
         "--slab-mu",
         type=float,
         default=1.0,
@@ -399,11 +406,28 @@ def slab(thickness_mm):
     return box
 
 
+def slab_edge():
+    """A 1 m half plane 3 mm above the slab over x < 0, casting a straight
+    shadow; the camera does not see it."""
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(-500.0 / MM_PER_UNIT, 0.0, 3.0 / MM_PER_UNIT))
+    plane = bpy.context.active_object
+    plane.scale = (1000.0 / MM_PER_UNIT, 1000.0 / MM_PER_UNIT, 1.0)
+    plane.visible_camera = False
+    # Black: the light the slab sends up must not come back into the shadow.
+    black = bpy.data.materials.new("occluder")
+    black.use_nodes = True
+    black.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0, 0, 0, 1)
+    black.node_tree.nodes["Principled BSDF"].inputs["Specular IOR Level"].default_value = 0.0
+    plane.data.materials.append(black)
+    return plane
+
+
 def slab_camera(args):
-    """Orthographic, 20 mm across the slab's centre, straight down."""
+    """Orthographic, 20 mm (with --slab-edge 24 mm) across the slab's centre,
+    straight down."""
     data = bpy.data.cameras.new("camera")
     data.type = "ORTHO"
-    data.ortho_scale = 20.0 / MM_PER_UNIT
+    data.ortho_scale = (24.0 if args.slab_edge else 20.0) / MM_PER_UNIT
     cam = bpy.data.objects.new("camera", data)
     bpy.context.scene.collection.objects.link(cam)
     tilt_slab_camera(cam, args.slab_mu)
@@ -445,6 +469,8 @@ def main():
     if args.slab_reflectance:
         args.slab, args.specular, args.sss = (0.5, 0.5, 0.5), "off", "on"
     head = slab(args.slab_thickness) if args.slab else import_head()
+    if args.slab and args.slab_edge:
+        slab_edge()
     head.data.materials.clear()
     head.data.materials.append(skin_material(args))
     if args.occlusion == "off":
