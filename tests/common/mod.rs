@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use dermis::gpu::{Context, ContextOptions, ValidationLog};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Runs `f` on a validated context, destroys the context, then asserts the layer
 /// said nothing of warning or error severity.
@@ -14,8 +14,18 @@ pub fn with_gpu<T>(f: impl FnOnce(&Arc<Context>) -> T) -> T {
     out
 }
 
+/// One test's context at a time. With two or more contexts alive in one
+/// process, NVIDIA's driver (580.159, the Debian 1.3.239 validation layer)
+/// kills a test thread with SIGSEGV, an instruction fetch from an unmapped
+/// library, whenever another test's context is destroyed (`--test-threads 2`:
+/// every run; `1`: none; README, "Tests"). A test's GPU work is the device's
+/// anyway: lavapipe runs each context on every core.
+static ONE_CONTEXT: Mutex<()> = Mutex::new(());
+
 /// Like [`with_gpu`] but hands the log back instead of asserting on it.
 pub fn with_gpu_log<T>(f: impl FnOnce(&Arc<Context>) -> T) -> (T, Arc<ValidationLog>) {
+    // A test that failed while holding it must not fail the others.
+    let _one = ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner());
     let ctx = Context::new(&ContextOptions {
         validation: true,
         device: std::env::var("DERMIS_DEVICE").ok(),
