@@ -61,11 +61,12 @@ vec3 transmitted(vec3 x, vec3 ng, vec3 n, vec2 params) {
         // faces away from x's (as light/transmission.rs counts the sky's): light
         // entering just before a terminator, or at the mesh's open cut, is what
         // the chain already carries along the surface.
-        if (dot(entry_normal(i, x), ng) >= 0.0) continue;
+        StoredDepths stored = stored_depths(i, x);
+        if (dot(entry_normal(i, stored), ng) >= 0.0) continue;
         float facing = max(dot(-n, l), 0.0);
         if (facing <= 0.0) continue;
         facing *= diffuse_transmission(facing, light_lobe(i, params));
-        sum += e * facing * transmittance(shadow_thickness(i, x, dist));
+        sum += e * facing * transmittance(shadow_thickness(i, stored, dist));
     }
     return sum;
 }

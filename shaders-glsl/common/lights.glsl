@@ -178,17 +178,26 @@ float soft_shadow(int i, vec3 x, vec3 ng) {
 #endif
 
 #ifdef SHADOW_DEPTH
-// The depths light i's map stores about x: the four texels around x's point
-// p in the map, (u0, v1), (u1, v1), (u1, v0), (u0, v0), read at uv, which
-// keeps them inside this light's tile of the atlas.
-vec4 stored_depths(int i, vec3 x, out vec3 p, out vec2 uv) {
+// The depths light i's map stores about x: the four texels z around x's
+// point p in the map, (u0, v1), (u1, v1), (u1, v0), (u0, v0), read at uv, which
+// keeps them inside this light's tile of the atlas. One gather serves both
+// shadow_thickness and entry_normal.
+struct StoredDepths {
+    vec4 z;
+    vec3 p;
+    vec2 uv;
+};
+
+StoredDepths stored_depths(int i, vec3 x) {
     vec4 s = frame.light_shadow[i] * vec4(x, 1.0);
-    p = s.xyz / s.w;
+    StoredDepths d;
+    d.p = s.xyz / s.w;
     vec2 size = vec2(textureSize(shadow_depth, 0));
     vec2 tiles = frame.params.zw;
-    vec2 lo = floor(p.xy * tiles) / tiles + 0.5 / size;
-    uv = clamp(p.xy, lo, lo + 1.0 / tiles - 1.0 / size);
-    return textureGather(shadow_depth, uv, 0);
+    vec2 lo = floor(d.p.xy * tiles) / tiles + 0.5 / size;
+    d.uv = clamp(d.p.xy, lo, lo + 1.0 / tiles - 1.0 / size);
+    d.z = textureGather(shadow_depth, d.uv, 0);
+    return d;
 }
 
 // The distance (mm) light i's ray to x travels inside the mesh before reaching
@@ -206,11 +215,10 @@ vec4 stored_depths(int i, vec3 x, out vec3 p, out vec2 uv) {
 // (light::shadow::ShadowView::thickness_mm mirrors this). From the whole-mesh
 // map: the profile's transmittance changes over millimetres, its 0.33 mm texels
 // do, and choosing the focus map cost the final pass 7-10 % when it looked the thickness up per pixel.
-float shadow_thickness(int i, vec3 x, float dist) {
-    vec3 p;
-    vec2 uv;
-    vec4 z = stored_depths(i, x, p, uv);
-    vec2 f = fract(uv * vec2(textureSize(shadow_depth, 0)) - 0.5);
+float shadow_thickness(int i, StoredDepths stored, float dist) {
+    vec4 z = stored.z;
+    vec3 p = stored.p;
+    vec2 f = fract(stored.uv * vec2(textureSize(shadow_depth, 0)) - 0.5);
     vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
     float range = frame.light_params[i].y;
     vec4 t;
@@ -233,10 +241,9 @@ float shadow_thickness(int i, vec3 x, float dist) {
 // positive scale (the gradient of z(u, v) − depth through the projection).
 // Unnormalised; across the light's silhouette the slope is steep and the
 // normal turns sideways.
-vec3 entry_normal(int i, vec3 x) {
-    vec3 p;
-    vec2 uv;
-    vec4 z = stored_depths(i, x, p, uv);
+vec3 entry_normal(int i, StoredDepths stored) {
+    vec4 z = stored.z;
+    vec3 p = stored.p;
     vec2 size = vec2(textureSize(shadow_depth, 0));
     mat4 m = frame.light_shadow[i];
     float zu = 0.5 * ((z.y + z.z) - (z.x + z.w)) * size.x;
