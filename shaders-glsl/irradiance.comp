@@ -53,7 +53,7 @@ void main() {
     vec3 w = vec3(1.0 - w12.x - w12.y, w12);
     vec3 x = vec3(0.0), occluded = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k) {
-        ivec2 at = vertex_values_texel(t[k] - 1u);
+        ivec2 at = vertex_values_texel(t[k] - 1u, textureSize(vertex_values, 0).x);
         x += w[k] * texelFetch(vertex_values, at, 0).xyz;
         occluded += w[k] * texelFetch(vertex_values, at + ivec2(1, 0), 0).xyz;
     }

@@ -25,7 +25,7 @@ void main() {
     if (vertex_index >= uint(vertices.length()) / VERTEX_FLOATS) return;
     uint v = vertex_index * VERTEX_FLOATS + POSITION_FLOAT;
     vec3 position = vec3(vertices[v], vertices[v + 1u], vertices[v + 2u]);
-    ivec2 at = vertex_values_texel(vertex_index);
+    ivec2 at = vertex_values_texel(vertex_index, imageSize(values).x);
     imageStore(values, at, vec4(position, 1.0));
     imageStore(values, at + ivec2(1, 0), vec4(occluded_irradiance(position), 1.0));
 }

@@ -38,7 +38,7 @@ const SURFACE_FORMAT: vk::Format = vk::Format::R16G16B16A16_UNORM;
 /// gutter) and two 16-bit weights.
 const TEXEL_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
 /// Vertices per row of the per-frame vertex values, two texels each
-/// (common/vertices.glsl).
+/// (common/vertices.glsl reads the row length from the image's width).
 const VERTICES_PER_ROW: u32 = 1024;
 
 pub struct IrradiancePass {
