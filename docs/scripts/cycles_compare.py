@@ -6,7 +6,8 @@
 dermis.exr: `dermis render --out X.exr` (linear, alpha = coverage) at the
 references' size and camera; each reference: the multilayer EXR the script
 writes (Combined and Position). Several references (seeds) are averaged; with
-two or more the script also gives their noise. Pixels count where the mesh
+two or more the script also gives their noise, and the mesh's RMS relative
+error with that noise taken out (from the first two seeds). Pixels count where the mesh
 covers the whole pixel in both (Cycles alpha > 0.999, dermis alpha > 0.5).
 
 Per group of pixels: the mean relative error of luminance (Rec. 709), each
@@ -248,6 +249,11 @@ def main():
         se = np.sqrt(np.pi / 2) * np.abs(la - lb) / 2 / np.sqrt(len(refs) / 2)
         result["ref_noise_rel"] = float((se / np.maximum(luminance(r), floor)).mean())
         result["seed_level"] = float(la.sum() / lb.sum())
+        # The RMS relative error without the reference's noise: for two
+        # independent seeds E[(d - a)(d - b)] = (d - truth)^2.
+        ld, f = luminance(d), np.maximum(luminance(r), floor)
+        result["rms_rel"] = float(np.sqrt((((ld - luminance(r)) / f) ** 2).mean()))
+        result["rms_rel_noise_free"] = float(np.sqrt(max(((ld - la) * (ld - lb) / f**2).mean(), 0.0)))
     for name, g in groups.items():
         if g.sum() == 0:
             continue
@@ -256,6 +262,7 @@ def main():
     print(f"coverage IoU {coverage_iou:.4f}, {mask.sum()} pixels")
     if "ref_noise_rel" in result:
         print(f"reference noise (mean relative standard error per pixel) {100 * result['ref_noise_rel']:.2f} %, seed level ratio {result['seed_level']:.4f}")
+        print(f"mesh RMS relative error {100 * result['rms_rel']:.2f} %, without the reference's noise {100 * result['rms_rel_noise_free']:.2f} % (first two seeds)")
     print(f"{'group':22s} {'pixels':>7s} {'mean':>7s} {'p90':>7s} {'level':>7s}   bias R / G / B")
     for name, s in result["groups"].items():
         bias = " / ".join(f"{100 * x:+.1f}" for x in s["bias_rgb"])

@@ -176,6 +176,14 @@ def parse_args(argv):
         "rho_s (the KS intensity the specular map gives, before the level) as emission",
     )
     p.add_argument(
+        "--subdivide",
+        type=int,
+        default=0,
+        help="Catmull-Clark levels on the scan (UVs interpolated linearly): the "
+        "walk then runs in a smoothed volume rather than the scan's flat "
+        "triangles, to measure the facets' share of a comparison",
+    )
+    p.add_argument(
         "--normal-pass",
         action="store_true",
         help="also write the Normal pass (world, Blender axes): the shading normal "
@@ -224,6 +232,8 @@ def parse_args(argv):
         p.error("--slab-thickness must be > 0")
     if not 0.0 < args.slab_mu <= 1.0:
         p.error("--slab-mu must be in (0, 1]")
+    if not 0 <= args.subdivide <= 3:
+        p.error("--subdivide takes 0 to 3 levels")
     for name in ("width", "height", "samples", "threads"):
         if getattr(args, name) < 1:
             p.error(f"--{name} must be >= 1")
@@ -469,6 +479,11 @@ def main():
     if args.slab_reflectance:
         args.slab, args.specular, args.sss = (0.5, 0.5, 0.5), "off", "on"
     head = slab(args.slab_thickness) if args.slab else import_head()
+    if args.subdivide and not args.slab:
+        sub = head.modifiers.new("subdivide", "SUBSURF")
+        sub.subdivision_type = "CATMULL_CLARK"
+        sub.levels = sub.render_levels = args.subdivide
+        sub.uv_smooth = "NONE"
     if args.slab and args.slab_edge:
         slab_edge()
     head.data.materials.clear()
