@@ -21,14 +21,14 @@ const vec3 REGION_COLORS[10] = vec3[](
     vec3(156, 117, 95), vec3(186, 176, 172));
 
 void main() {
+    vec3 dpdx = dFdx(v_position), dpdy = dFdy(v_position);
     vec3 c;
     if (pc.mode == 0u) {
         float z = dot(v_position - frame.camera_pos.xyz, pc.forward_near.xyz);
         c = vec3(clamp((pc.far - z) / (pc.far - pc.forward_near.w), 0.0, 1.0));
     } else if (pc.mode == 1u) {
         vec3 n = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-        // Two-sided by the geometric normal, as the shading passes.
-        if (dot(v_normal, frame.camera_pos.xyz - v_position) < 0.0) n = -n;
+        if (seen_from_behind(v_normal, frame.camera_pos.xyz - v_position, dpdx, dpdy)) n = -n;
         c = 0.5 * n + 0.5;
     } else if (pc.mode == 2u) {
         c = texture(albedo_tex, v_uv).rgb;

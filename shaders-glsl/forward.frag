@@ -29,9 +29,8 @@ layout(location = 0) out vec4 color;
 
 vec3 shading_normal() {
     vec3 s = map_normal(normal_tex, v_uv, v_normal, v_tangent);
-    // Two-sided by the geometric normal, whatever the mesh's winding.
     vec3 v = frame.camera_pos.xyz - v_position;
-    return dot(v_normal, v) < 0.0 ? -s : s;
+    return seen_from_behind(v_normal, v, shading_dpdx, shading_dpdy) ? -s : s;
 }
 
 void main() {

@@ -102,8 +102,7 @@ void main() {
     vec2 params = specular_params(v_uv);
     vec3 albedo = texture(albedo_tex, v_uv).rgb;
     vec3 v = normalize(frame.camera_pos.xyz - v_position);
-    // Two-sided by the geometric normal, whatever the mesh's winding.
-    bool back_side = dot(v_normal, v) < 0.0;
+    bool back_side = seen_from_behind(v_normal, v, shading_dpdx, shading_dpdy);
     float n_dot_v = clamp(dot(back_side ? -n : n, v), 0.0, 1.0);
     // (A(N·V, m), Ā(m)): the specular's albedo toward the viewer and over
     // the hemisphere.

@@ -735,3 +735,43 @@ fn the_scans_specular_share_under_a_uniform_sky() {
     );
     assert!((0.05..=0.10).contains(&share), "{share}");
 }
+
+#[test]
+fn a_polyhedrons_silhouette_is_shaded_as_its_front() {
+    // Near a coarse sphere's silhouette the interpolated vertex normal faces
+    // away from the camera on faces that face it: the front, whose normal
+    // must stay outward (two-sided shading turns only the back's). The
+    // `normals` view shows the shading normal every shading pass uses.
+    let s = scene(
+        sphere(Vec3::ZERO, R, 8, 4, (0.0, 1.0)),
+        Vec::new(),
+        EnvMap::uniform(Vec3::ONE, 64, 32),
+    );
+    let img = render(&s, View::named("normals"));
+    let inv = s.camera.view_projection(1.0).inverse();
+    let (mut leaning_away, mut inward, mut covered) = (0, 0, 0);
+    for (k, px) in img.chunks_exact(4).enumerate() {
+        if px[3] < 1.0 {
+            continue;
+        }
+        covered += 1;
+        let n = Vec3::new(px[0], px[1], px[2]) * 2.0 - 1.0;
+        let ndc = |z| {
+            let (x, y) = ((k as u32 % SIZE) as f32, (k as u32 / SIZE) as f32);
+            let p = (Vec2::new(x + 0.5, y + 0.5) / SIZE as f32) * 2.0 - 1.0;
+            inv.project_point3(Vec3::new(p.x, p.y, z))
+        };
+        let d = (ndc(1.0) - ndc(0.0)).normalize();
+        // The ray's nearest approach to the centre, outward across the view.
+        let o = s.camera.position;
+        let across = o - d * o.dot(d);
+        leaning_away += usize::from(n.dot(d) > 0.0);
+        inward += usize::from(across.length() > 0.1 * R && n.dot(across) < 0.0);
+    }
+    println!("{covered} pixels, {leaning_away} with the normal leaning away, {inward} inward");
+    assert!(
+        covered > 10_000 && leaning_away >= 50,
+        "{covered} {leaning_away}"
+    );
+    assert_eq!(inward, 0);
+}

@@ -11,7 +11,7 @@
 //!   the perspective-correct weights); the shading normal is the vertex normal,
 //!   or (`Settings::normal_map`) the normal map decoded as
 //!   `common/normal_map.glsl` does, flipped when the interpolated vertex normal
-//!   faces away from the camera; alpha 1;
+//!   lies on the far side of the triangle from the camera; alpha 1;
 //! - behind it (`background.frag`, `light/skybox.rs`) with `render.skybox`: the
 //!   environment bilinearly sampled along the ray through the far plane,
 //!   `env_dir`-rotated, × intensity, alpha 0 (alpha is the coverage); without:
@@ -187,8 +187,12 @@ fn shade(
     } else {
         normal.normalize_or(geometric)
     };
-    // Two-sided by the interpolated vertex normal, as forward.frag.
-    let side = if normal.dot(scene.camera.position - x) < 0.0 {
+    // Two-sided, as forward.frag: the back is seen where the interpolated
+    // vertex normal lies on the far side of the hit triangle's plane. (Not
+    // where it faces away from the camera: at a closed surface's silhouette
+    // it may, on the front.)
+    let toward_camera = geometric * geometric.dot(scene.camera.position - x).signum();
+    let side = if normal.dot(toward_camera) < 0.0 {
         n = -n;
         -1.0
     } else {
@@ -341,6 +345,51 @@ mod tests {
             );
             assert_eq!(image.converged, 1.0);
         }
+    }
+
+    #[test]
+    fn a_polyhedrons_silhouette_is_its_front() {
+        // Near a polyhedron's silhouette the interpolated vertex normal may face
+        // away from the camera on a face that faces it: the front, which sees
+        // the whole sky. Taken for the back, its hemisphere would lie inside.
+        let mut scene = sphere_scene(false);
+        scene.mesh = sphere(50.0, 4, 8);
+        for p in &mut scene.mesh.positions {
+            *p += Vec3::Y * 60.0;
+        }
+        let (w, h) = (96, 72);
+        let image = render_view(&scene, w, h, &Settings::default()).unwrap();
+        let integrator =
+            Integrator::new(&scene.mesh, &scene.env, 0.0, 1.0, &[], &Settings::default());
+        let inv = scene.camera.view_projection(w as f32 / h as f32).inverse();
+        let albedo = Vec3::splat(((188.0 / 255.0 + 0.055) / 1.055f32).powf(2.4));
+        let (mut leaning_away, mut darkest) = (0, f32::INFINITY);
+        for j in 0..h {
+            for i in 0..w {
+                let p = Vec4::from_slice(&image.rgba[4 * (j * w + i) as usize..]);
+                if p.w == 0.0 {
+                    continue;
+                }
+                darkest = darkest.min((p.xyz() / (albedo * SKY)).min_element());
+                let ndc = Vec2::new(
+                    (i as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                    (j as f32 + 0.5) / h as f32 * 2.0 - 1.0,
+                );
+                let near = inv.project_point3(ndc.extend(0.0));
+                let far = inv.project_point3(ndc.extend(1.0));
+                let hit = integrator.bvh().closest_hit(near, far - near, 1.0).unwrap();
+                let m = &scene.mesh;
+                let k = 3 * hit.triangle as usize;
+                let b = hit.barycentric;
+                let [n0, n1, n2] = [0, 1, 2].map(|c| m.normals[m.indices[k + c] as usize]);
+                let normal = n0 * b.x + n1 * b.y + n2 * b.z;
+                leaning_away += usize::from(normal.dot(near - far) < 0.0);
+            }
+        }
+        println!("{leaning_away} pixels whose vertex normal faces away; darkest {darkest:.3} of albedo·L");
+        assert!(leaning_away >= 10, "{leaning_away}");
+        // The lift to the corners' planes leaves the front all its sky.
+        assert!(darkest > 0.9, "{darkest}");
     }
 
     #[test]
