@@ -136,19 +136,10 @@ fn hit(o: Vec3, d: Vec3, (c, r): (Vec3, f32)) -> Option<f32> {
 /// For each screen pixel of `scene`'s camera, the first point hit on `spheres`
 /// with the index of the sphere, or `None`.
 fn pixel_hits(camera: &Camera, spheres: &[(Vec3, f32)]) -> Vec<Option<(usize, Vec3)>> {
-    let inv = camera.view_projection(1.0).inverse();
     let mut out = Vec::new();
     for y in 0..SIZE {
         for x in 0..SIZE {
-            let ndc = |z| {
-                let p = Vec2::new(
-                    (x as f32 + 0.5) / SIZE as f32,
-                    (y as f32 + 0.5) / SIZE as f32,
-                ) * 2.0
-                    - 1.0;
-                inv.project_point3(Vec3::new(p.x, p.y, z))
-            };
-            let (o, d) = (camera.position, (ndc(1.0) - ndc(0.0)).normalize());
+            let (o, d) = (camera.position, pixel_ray(camera, x, y));
             let nearest = spheres
                 .iter()
                 .enumerate()
@@ -158,6 +149,14 @@ fn pixel_hits(camera: &Camera, spheres: &[(Vec3, f32)]) -> Vec<Option<(usize, Ve
         }
     }
     out
+}
+
+/// The unit direction of the ray through the centre of screen pixel (x, y).
+fn pixel_ray(camera: &Camera, x: u32, y: u32) -> Vec3 {
+    let inv = camera.view_projection(1.0).inverse();
+    let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0;
+    let ndc = |z| inv.project_point3(Vec3::new(p.x, p.y, z));
+    (ndc(1.0) - ndc(0.0)).normalize()
 }
 
 /// Compares `got` (one channel per pixel) to `expected` where it is `Some`:
@@ -748,7 +747,6 @@ fn a_polyhedrons_silhouette_is_shaded_as_its_front() {
         EnvMap::uniform(Vec3::ONE, 64, 32),
     );
     let img = render(&s, View::named("normals"));
-    let inv = s.camera.view_projection(1.0).inverse();
     let (mut leaning_away, mut inward, mut covered) = (0, 0, 0);
     for (k, px) in img.chunks_exact(4).enumerate() {
         if px[3] < 1.0 {
@@ -756,12 +754,7 @@ fn a_polyhedrons_silhouette_is_shaded_as_its_front() {
         }
         covered += 1;
         let n = Vec3::new(px[0], px[1], px[2]) * 2.0 - 1.0;
-        let ndc = |z| {
-            let (x, y) = ((k as u32 % SIZE) as f32, (k as u32 / SIZE) as f32);
-            let p = (Vec2::new(x + 0.5, y + 0.5) / SIZE as f32) * 2.0 - 1.0;
-            inv.project_point3(Vec3::new(p.x, p.y, z))
-        };
-        let d = (ndc(1.0) - ndc(0.0)).normalize();
+        let d = pixel_ray(&s.camera, k as u32 % SIZE, k as u32 / SIZE);
         // The ray's nearest approach to the centre, outward across the view.
         let o = s.camera.position;
         let across = o - d * o.dot(d);
