@@ -103,19 +103,7 @@ impl Image {
             external: false,
         };
         let requirements = unsafe { device.get_image_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|source| Error::Alloc {
-                name: name.into(),
-                source,
-            })?;
+        let allocation = allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false)?;
         unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
         image.allocation = Some(allocation);
@@ -203,6 +191,29 @@ pub struct Buffer {
     allocation: Option<Allocation>,
 }
 
+/// Memory for a resource from the allocator (`linear`: a buffer, not an
+/// optimally tiled image), named `name`.
+fn allocate(
+    ctx: &Context,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation> {
+    ctx.allocator()
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|source| Error::Alloc {
+            name: name.into(),
+            source,
+        })
+}
+
 impl Buffer {
     /// `location`: `GpuOnly` for device data, `CpuToGpu` for uploads, `GpuToCpu` for readback.
     pub fn new(
@@ -226,19 +237,7 @@ impl Buffer {
             allocation: None,
         };
         let requirements = unsafe { device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|source| Error::Alloc {
-                name: name.into(),
-                source,
-            })?;
+        let allocation = allocate(ctx, name, requirements, location, true)?;
         unsafe { device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }
             .vk("vkBindBufferMemory")?;
         buffer.allocation = Some(allocation);
