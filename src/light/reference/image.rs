@@ -246,9 +246,10 @@ mod tests {
 
     const SKY: Vec3 = Vec3::new(0.2, 0.5, 1.0);
 
-    /// A 50 mm sphere above the camera's target under a uniform sky, grey albedo.
-    fn sphere_scene(skybox: bool) -> Scene {
-        let mut mesh = sphere(50.0, 24, 48);
+    /// A 50 mm sphere of `rings` × `segments` above the camera's target under
+    /// a uniform sky, grey albedo.
+    fn sphere_scene(skybox: bool, rings: u32, segments: u32) -> Scene {
+        let mut mesh = sphere(50.0, rings, segments);
         for p in &mut mesh.positions {
             *p += Vec3::Y * 60.0;
         }
@@ -300,7 +301,7 @@ mod tests {
         let (w, h) = (64, 48);
         let albedo = Vec3::splat(((188.0 / 255.0 + 0.055) / 1.055f32).powf(2.4));
         for skybox in [true, false] {
-            let scene = sphere_scene(skybox);
+            let scene = sphere_scene(skybox, 24, 48);
             let image = render_view(&scene, w, h, &Settings::default()).unwrap();
             let (mut worst, mut sum_sq, mut checked) = (0.0f32, 0.0f32, 0);
             for j in 0..h {
@@ -352,11 +353,7 @@ mod tests {
         // Near a polyhedron's silhouette the interpolated vertex normal may face
         // away from the camera on a face that faces it: the front, which sees
         // the whole sky. Taken for the back, its hemisphere would lie inside.
-        let mut scene = sphere_scene(false);
-        scene.mesh = sphere(50.0, 4, 8);
-        for p in &mut scene.mesh.positions {
-            *p += Vec3::Y * 60.0;
-        }
+        let scene = sphere_scene(false, 4, 8);
         let (w, h) = (96, 72);
         let image = render_view(&scene, w, h, &Settings::default()).unwrap();
         let integrator =
