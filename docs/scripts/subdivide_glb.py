@@ -8,12 +8,28 @@ transfer is sampled more densely (docs/skin.md, "What the numbers point to").
 import json, os, struct, sys
 import numpy as np
 
-if len(sys.argv) != 4 or not sys.argv[3].isdigit():
-    sys.exit("usage: subdivide_glb.py IN.glb OUT.glb LEVELS")
+if len(sys.argv) != 4 or not sys.argv[3].isdigit() or not 0 < int(sys.argv[3]) <= 3:
+    sys.exit("usage: subdivide_glb.py IN.glb OUT.glb LEVELS (1 to 3)")
 src, dst, levels = sys.argv[1], sys.argv[2], int(sys.argv[3])
-b = open(src, 'rb').read()
+if not os.path.isdir(os.path.dirname(os.path.abspath(dst))):
+    sys.exit(f"{dst}: no such folder")
+try:
+    b = open(src, 'rb').read()
+except OSError as e:
+    sys.exit(f"{src}: {e.strerror}")
+if len(b) < 20 or b[:4] != b'glTF':
+    sys.exit(f"{src}: not a binary glTF (GLB)")
 jl, _ = struct.unpack('<II', b[12:20]); j = json.loads(b[20:20 + jl])
 bin_off = 20 + jl; bl, _ = struct.unpack('<II', b[bin_off:bin_off + 8]); binary = b[bin_off + 8:bin_off + 8 + bl]
+# What the rewrite below keeps: one mesh of one indexed triangle primitive with
+# exactly these attributes, tightly packed.
+prims = [q for m in j.get('meshes', []) for q in m['primitives']]
+if len(prims) != 1 or prims[0].get('mode', 4) != 4 or 'indices' not in prims[0]:
+    sys.exit(f"{src}: needs one mesh of one indexed triangle primitive")
+if set(prims[0]['attributes']) != {'POSITION', 'NORMAL', 'TEXCOORD_0'}:
+    sys.exit(f"{src}: needs exactly POSITION, NORMAL and TEXCOORD_0, has {sorted(prims[0]['attributes'])}")
+if any('byteStride' in v for v in j['bufferViews']):
+    sys.exit(f"{src}: interleaved buffer views are not handled")
 def acc(i):
     a = j['accessors'][i]; v = j['bufferViews'][a['bufferView']]
     dt = {5123: np.uint16, 5125: np.uint32, 5126: np.float32}[a['componentType']]
