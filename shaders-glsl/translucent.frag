@@ -7,7 +7,8 @@
 // facing away from this one (a thin part's far side), the light's irradiance
 // on the light-facing surface — its normal taken as −n, the light entering less what
 // the specular reflects there (this point's ρs, m) — through the thickness the
-// shadow map gives, T(d) = Σ wᵢ exp(−d²/2vᵢ). Both sides of the surface, as
+// shadow map gives, T(d) = Σ wᵢ exp(−d²/2vᵢ) or, with a medium, its walked
+// T(d) (skin::medium_tables). Both sides of the surface, as
 // the final pass shades both: front (the mesh's normal) and back (reversed);
 // premultiplied by coverage (alpha 1 on the mesh, 0 in the gutter) so that the
 // final pass renormalises where its bilinear lookup reaches past a chart's
@@ -26,8 +27,15 @@ layout(binding = 3) uniform sampler2D normal_tex;
 #define SPEC_ROUGHNESS 8
 #include "ks_specular.glsl"
 #include "normal_map.glsl"
-// rgb the Gaussians' weights, w their variances (mm²).
-layout(push_constant) uniform Push { vec4 weights[6]; } pc;
+// A medium's T(d) divided by its albedo, sample i at d = table_max_mm·(i/(n − 1))²
+// (skin::medium_tables; the final pass multiplies by the albedo).
+layout(binding = 9) uniform sampler2D transmittance_table;
+// weights: rgb the Gaussians' weights, w their variances (mm²); table_max_mm:
+// the thickness of the table's last sample.
+layout(push_constant) uniform Push { vec4 weights[6]; float table_max_mm; } pc;
+// T(d) from the medium's table instead of the Gaussians
+// (skin::translucent::TranslucentPass::new).
+layout(constant_id = 5) const bool TABLE = false;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
@@ -38,6 +46,12 @@ layout(location = 1) out vec4 back;
 // T(d) = Σ wᵢ exp(−d²/2vᵢ): the profile through a slab d mm thick, per channel
 // (G(v, √(r² + d²)) = G(v, r)·exp(−d²/2v); skin::profile::Profile::transmittance).
 vec3 transmittance(float d) {
+    if (TABLE) {
+        if (d > pc.table_max_mm) return vec3(0.0);
+        float n = float(textureSize(transmittance_table, 0).x);
+        float u = (sqrt(d / pc.table_max_mm) * (n - 1.0) + 0.5) / n;
+        return textureLod(transmittance_table, vec2(u, 0.5), 0.0).rgb;
+    }
     vec3 t = vec3(0.0);
     for (int k = 0; k < 6; ++k) {
         float v = pc.weights[k].w;

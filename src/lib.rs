@@ -4,6 +4,7 @@
 
 pub mod assets;
 pub mod atomic;
+pub mod cache;
 pub mod error;
 pub mod frame;
 pub mod gpu;

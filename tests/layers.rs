@@ -18,7 +18,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "graph"],
     &["profile"],
     &["gpu"],
-    &["atomic"],
+    &["atomic", "cache"],
     &["error", "assets", "text"],
 ];
 

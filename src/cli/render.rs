@@ -112,7 +112,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         warmup_ms: args.warmup_ms,
     };
     opts.warmup_frames()?;
-    let loaded = Scene::load(args.overrides.apply(file)?)?;
+    let loaded = dermis::skin::with_medium_albedo(Scene::load(args.overrides.apply(file)?)?);
     let ctx = Context::new(context)?;
     if opts.view.name() == "list" {
         for name in dermis::render::views(&ctx, &loaded)? {
@@ -184,7 +184,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
 /// `dermis precompute`.
 pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Result<()> {
     let file = args.scene.load(&args.overrides)?;
-    let scene = dermis::scene::Scene::load(file)?;
+    let scene = dermis::skin::with_medium_albedo(dermis::scene::Scene::load(file)?);
     let (mesh, skin) = (&scene.mesh, &scene.file.skin);
     let ctx = Context::new(context)?;
     let started = std::time::Instant::now();

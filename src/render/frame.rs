@@ -293,7 +293,13 @@ impl Passes {
                 skin.blur_amount < 1.0,
                 chain::unblurred_levels(levels),
             )?,
-            translucent: TranslucentPass::new(p, variant, res, transmits)?,
+            translucent: TranslucentPass::new(
+                p,
+                variant,
+                res,
+                transmits,
+                skin.medium.as_ref().map(|m| &m.tables),
+            )?,
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res, false)?,
             hard_visibility: VisibilityPass::new(p, variant, res, true)?,
@@ -386,13 +392,18 @@ impl Frame {
         })?;
         let m = &scene.mesh;
         let specular_map = (scene.specular.width, scene.specular.height);
-        let specular_scale = 0.5
-            / specular::map_mean(
+        // 1/(2s̄) of the specular map's rule; 0 turns the map off (a medium's
+        // boundary has one ρs).
+        let specular_scale = if !skin.specular_map_applies() {
+            0.0
+        } else {
+            0.5 / specular::map_mean(
                 &m.positions,
                 &m.uvs,
                 &m.indices,
                 (specular_map.0, specular_map.1, &scene.specular.rgba8),
-            );
+            )
+        };
         let uniforms = frame_uniforms(scene, &lighting, w as f32 / h as f32, specular_scale);
         let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms, &skin)?;
         let s = &inputs.samplers;

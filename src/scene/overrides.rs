@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use super::env::EnvSource;
 use super::file::{
-    self, parse_env_source, Chain, IrradianceShading, Kernel, LightsMode, Occlusion, SceneFile,
-    ToneCurve, UvOrigin,
+    self, parse_env_source, Chain, IrradianceShading, Kernel, LightsMode, MediumPreset, Occlusion,
+    SceneFile, ToneCurve, UvOrigin,
 };
 use crate::error::Result;
 
@@ -155,6 +155,12 @@ overrides! {
     /// from shadowed lights behind it; 0: off. Replaces `skin.transmission`.
     #[arg(allow_hyphen_values = true)]
     transmission: f32 => skin.transmission, example "0.5";
+    /// The skin's medium, replacing `skin.medium.preset`: `deon2007` (the
+    /// paper's Gaussians) or one of Jensen et al. 2001's measured media, from
+    /// which the profile, the transmission and the specular follow
+    /// (docs/skin.md, "Media").
+    #[arg(value_enum)]
+    medium: MediumPreset => skin.medium.preset, example "jensen-skin1";
     /// Blur along the surface metric of the UVs, shear included (off: along u
     /// and v, their scale only), replacing `skin.shear_correction`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]

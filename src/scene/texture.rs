@@ -84,6 +84,21 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// IEC 61966-2-1 sRGB encoding of a linear value, clamped to [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// [`linear_to_srgb`] as an 8-bit value, rounded.
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    (linear_to_srgb(c) * 255.0).round() as u8
+}
+
 /// Loads a PNG or JPEG file (the format is detected from the content) as RGBA8.
 pub fn load_texture(path: &Path, encoding: Encoding) -> Result<Texture, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io {

@@ -4,7 +4,10 @@
 
 pub mod blur;
 pub mod chain;
+pub mod fit;
 pub mod irradiance;
+pub mod medium;
+pub mod medium_tables;
 pub mod profile;
 pub mod reference;
 pub mod shade;
@@ -12,15 +15,22 @@ pub mod specular;
 pub mod stretch;
 pub mod tables;
 pub mod translucent;
+pub mod walk;
 
 use crate::error::{Error, Result};
 use crate::frame::Vertex;
 use crate::gpu::{GraphicsDesc, Pipeline, Pipelines};
-use crate::scene::file::{Chain, Kernel as KernelChoice, Render, Skin, SpecularRegion};
+use crate::scene::file::{
+    Chain, Kernel as KernelChoice, Render, Skin, SpecularRegion, SpecularRule,
+};
 use crate::scene::mesh::Mesh;
+use crate::scene::texture::{Encoding, Texture};
+use crate::scene::Scene;
 use ash::vk;
 use blur::BlurKernel;
 use glam::Vec3;
+use medium::Medium;
+use medium_tables::MediumTables;
 use profile::{Gaussian, Kernel, Profile};
 use std::sync::Arc;
 
@@ -63,11 +73,38 @@ pub struct SkinSettings {
     /// perpendicular of ∂P/∂u (skin::stretch::StretchTensor); off: the diagonal
     /// only, u then v.
     pub shear_correction: bool,
+    /// The medium the profile was fitted to, and its tables; `None` for
+    /// `deon2007` (the paper's Gaussians).
+    pub medium: Option<MediumSkin>,
+    /// The profile the exact-diffusion reference convolves with: a medium's
+    /// dense fit of its R(r) (skin::fit::fit_reference), else `profile`;
+    /// `skin.blur_width` applied.
+    pub reference_profile: Profile,
 }
+
+/// A medium's share of the settings (`[skin.medium]`).
+#[derive(Clone, Debug)]
+pub struct MediumSkin {
+    pub medium: Medium,
+    pub tables: MediumTables,
+    /// The specular lobe: the medium's boundary, or the paper's regions.
+    pub specular: SpecularRule,
+}
+
+/// ρs that makes the KS lobe a rough dielectric's reflection: KS is
+/// ρs·PH·F/(h·h) with d'Eon's PH = π·D (skin::specular::beckmann_ph) and
+/// h·h = 4(H·V)², so ρs = 1/π gives D·F/(4(H·V)²), the Cook–Torrance lobe with
+/// Kelemen & Szirmay-Kalos's G/(cos θi cos θo) ≈ 1/(H·V)² (skin::specular's
+/// tests hold its albedo against Smith's microfacet one).
+pub const BOUNDARY_RHO_S: f32 = 1.0 / std::f32::consts::PI;
 
 impl SkinSettings {
     pub fn resolve(skin: &Skin, render: &Render) -> Result<Self> {
+        let medium = medium_skin(skin);
         let profile = match &skin.profile {
+            _ if medium.is_some() => medium
+                .as_ref()
+                .map_or_else(Profile::skin, |m| m.tables.profile()),
             Some(p) => Profile {
                 gaussians: p
                     .iter()
@@ -88,11 +125,18 @@ impl SkinSettings {
         profile
             .validate()
             .map_err(|e| Error::Input(format!("skin profile: {e}")))?;
-        let mut profile = profile;
-        for g in &mut profile.gaussians {
-            g.variance_mm2 *= skin.blur_width;
-        }
-        let regions = skin.regions.clone().unwrap_or_else(|| {
+        let widen = |mut p: Profile| {
+            for g in &mut p.gaussians {
+                g.variance_mm2 *= skin.blur_width;
+            }
+            p
+        };
+        let profile = widen(profile);
+        let reference_profile = match &medium {
+            Some(m) => widen(m.tables.reference_profile()),
+            None => profile.clone(),
+        };
+        let mut regions = skin.regions.clone().unwrap_or_else(|| {
             specular::default_regions()
                 .iter()
                 .map(|r| SpecularRegion {
@@ -102,6 +146,11 @@ impl SkinSettings {
                 })
                 .collect()
         });
+        if medium.as_ref().is_some_and(MediumSkin::boundary_specular) {
+            for r in &mut regions {
+                r.rho_s = BOUNDARY_RHO_S;
+            }
+        }
         Ok(Self {
             profile,
             blur_amount: skin.blur_amount,
@@ -116,8 +165,61 @@ impl SkinSettings {
             stretch_correction: skin.stretch_correction,
             transmission: skin.transmission,
             shear_correction: skin.shear_correction,
+            medium,
+            reference_profile,
         })
     }
+
+    /// The specular map raises ρs (d'Eon's rule) only with the regions' lobe:
+    /// a medium's boundary has one ρs.
+    pub fn specular_map_applies(&self) -> bool {
+        !self
+            .medium
+            .as_ref()
+            .is_some_and(MediumSkin::boundary_specular)
+    }
+}
+
+impl MediumSkin {
+    pub fn boundary_specular(&self) -> bool {
+        self.specular == SpecularRule::Boundary
+    }
+}
+
+/// The scene's medium and its tables (walked and fitted, or from the cache);
+/// `None` for `deon2007`.
+fn medium_skin(skin: &Skin) -> Option<MediumSkin> {
+    let medium = Medium::from_spec(&skin.medium)?;
+    let tables = MediumTables::load_or_compute(&medium, &crate::cache::default_cache_dir());
+    log::info!(
+        "medium {}: albedo {:.3?}, fit error {:.3?} (walks {:.2} s, fits {:.2} s)",
+        medium.key(),
+        tables.albedo,
+        tables.fit_error,
+        tables.walk_seconds,
+        tables.fit_seconds
+    );
+    Some(MediumSkin {
+        medium,
+        tables,
+        specular: skin.medium.specular.unwrap_or(SpecularRule::Boundary),
+    })
+}
+
+/// `scene` with its skin's colour: where the scene names a medium and no
+/// albedo map (nor the test texture), the medium's own albedo, uniform; else
+/// unchanged (the map's colour with the medium's profile).
+pub fn with_medium_albedo(mut scene: Scene) -> Scene {
+    let t = &scene.file.textures;
+    if t.albedo.is_some() || t.test_texture {
+        return scene;
+    }
+    if let Some(medium) = Medium::from_spec(&scene.file.skin.medium) {
+        let tables = MediumTables::load_or_compute(&medium, &crate::cache::default_cache_dir());
+        let srgb = tables.albedo.map(crate::scene::texture::linear_to_srgb8);
+        scene.albedo = Texture::solid([srgb[0], srgb[1], srgb[2], 255], Encoding::Srgb);
+    }
+    scene
 }
 
 /// Texels per millimetre of the whole atlas: √(UV area in texels² / surface

@@ -8,11 +8,13 @@
 //! bilinear lookup instead of a shadow-map thickness and six exponentials per
 //! light and pixel (issue 24; docs/performance.md).
 
+use super::medium_tables::MediumTables;
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
 use crate::frame::{FrameInputs, ShaderVariant};
 use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
+use crate::graph::upload::upload_texture;
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
 use std::sync::Arc;
@@ -31,16 +33,31 @@ pub struct TranslucentPass {
     /// them to bind.
     on: bool,
     textures: [Arc<Image>; 2],
+    /// A medium's T(d)/albedo by thickness (1×1 and unread without one).
+    table: Arc<Image>,
+    /// The thickness of the table's last sample, mm; 0 without a medium.
+    table_max_mm: f32,
+}
+
+/// translucent.frag's push constants.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Constants {
+    /// Per Gaussian its RGB weight and its variance (mm²).
+    profile: [[f32; 4]; 6],
+    table_max_mm: f32,
 }
 
 impl TranslucentPass {
     /// The pass and its textures at min(`resolution`, [`MAX_RESOLUTION`])² for
-    /// an irradiance texture of `resolution`²; `on`: the scene transmits.
+    /// an irradiance texture of `resolution`²; `on`: the scene transmits;
+    /// `medium`: T(d) from its table instead of the profile's Gaussians.
     pub fn new(
         pipelines: &Pipelines,
         variant: &ShaderVariant,
         resolution: u32,
         on: bool,
+        medium: Option<&MediumTables>,
     ) -> Result<Self> {
         let ctx = pipelines.ctx();
         let on = on && variant.shadowed != 0;
@@ -54,15 +71,43 @@ impl TranslucentPass {
             | vk::ImageUsageFlags::TRANSFER_SRC;
         let desc = ImageDesc::new(side, side, UV_FORMAT);
         let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
+        // T(d)/albedo: the final pass multiplies the transmitted light by the
+        // albedo (the medium's own, or the map's colour on the medium's shape).
+        let texels: Vec<[f32; 4]> = match medium {
+            Some(t) => t
+                .transmittance
+                .iter()
+                .map(|v| {
+                    let per = |c: usize| v[c] / t.albedo[c].max(1e-6);
+                    [per(0), per(1), per(2), 1.0]
+                })
+                .collect(),
+            None => vec![[0.0; 4]],
+        };
+        let halves: Vec<u8> = texels
+            .iter()
+            .flatten()
+            .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+            .collect();
+        let table = upload_texture(
+            ctx,
+            "transmittance table",
+            ImageDesc::new(texels.len() as u32, 1, UV_FORMAT),
+            &halves,
+        )?;
+        let mut specialization = variant.specialization().to_vec();
+        specialization.push(u32::from(medium.is_some()));
         Ok(Self {
             pipeline: uv_pipeline(
                 pipelines,
                 ("uv.vert", "translucent.frag"),
                 &[UV_FORMAT; 2],
-                &variant.specialization(),
+                &specialization,
             )?,
             on,
             textures: [image(NAMES[0])?, image(NAMES[1])?],
+            table,
+            table_max_mm: medium.map_or(0.0, |t| t.max_thickness_mm),
         })
     }
 
@@ -93,9 +138,13 @@ impl TranslucentPass {
         let [front, back] = &mut out;
         let pass = tables
             .bind(pass, inputs)
+            .texture(&self.table, &s.linear)
             .color(front, LoadOp::Clear([0.0; 4]))
             .color(back, LoadOp::Clear([0.0; 4]))
-            .constants(profile);
+            .constants(&Constants {
+                profile: *profile,
+                table_max_mm: self.table_max_mm,
+            });
         if self.on {
             inputs.mesh.draw(pass);
         } else {

@@ -160,7 +160,7 @@ pub fn run(
     if let Some(dir) = &opts.out_dir {
         super::output::create_dir(dir)?;
     }
-    let mut scene = Scene::load(opts.scene.clone())?;
+    let mut scene = crate::skin::with_medium_albedo(Scene::load(opts.scene.clone())?);
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;
     if skin.profile.gaussians.iter().any(|g| g.variance_mm2 <= 0.0) {
         return Err(Error::Input(format!(
@@ -453,13 +453,11 @@ fn exact(scene: &Scene, skin: &SkinSettings, irradiance: &Level, stride: u32) ->
             "reference --diffusion: the mesh covers no texel".into(),
         ));
     }
-    let variances: Vec<f32> = skin
-        .profile
-        .gaussians
-        .iter()
-        .map(|g| g.variance_mm2)
-        .collect();
-    let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
+    // A medium's dense fit of its R(r): the reference measures the chain's
+    // six-Gaussian fit too.
+    let profile = &skin.reference_profile;
+    let variances: Vec<f32> = profile.gaussians.iter().map(|g| g.variance_mm2).collect();
+    let weights: Vec<Vec3> = profile.gaussians.iter().map(|g| g.weights).collect();
     let e: Vec<Vec3> = texels
         .iter()
         .map(|t| irradiance.at(t.uv).unwrap_or(Vec3::ZERO))

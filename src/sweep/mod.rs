@@ -214,7 +214,7 @@ impl<'a> Session<'a> {
         validate(opts)?;
         let mut file = opts.scene.clone();
         file.render.skybox = false;
-        let mut scene = Scene::load(file)?;
+        let mut scene = crate::skin::with_medium_albedo(Scene::load(file)?);
         let reference = points::reference(opts);
         let task = Task::new(
             &format!("sweep: reference {} (2 renders)", reference.id()),

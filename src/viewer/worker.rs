@@ -152,7 +152,10 @@ fn render(ctx: &Arc<Context>, session: &mut Option<Session>, job: &Job) -> Resul
     if !taken {
         *session = None; // free the old one's memory first
         (file.render.width, file.render.height) = job.size;
-        *session = Some(Session::new(ctx, Scene::load(file)?)?);
+        *session = Some(Session::new(
+            ctx,
+            crate::skin::with_medium_albedo(Scene::load(file)?),
+        )?);
     }
     let s = session.as_mut().expect("made above");
     s.set_camera(job.camera, job.size)?;

@@ -9,6 +9,7 @@
 mod camera;
 mod environment;
 mod error;
+mod medium;
 mod render;
 mod skin;
 #[cfg(test)]
@@ -26,6 +27,7 @@ pub use environment::{
 };
 use error::one_line;
 pub use error::SceneError;
+pub use medium::{Inversion, Medium, MediumPreset, SpecularRule, MAX_IOR};
 pub use render::{Gamma, IrradianceShading, Render, ToneCurve, MAX_RENDER_SIZE};
 pub use skin::{
     Chain, Kernel, Occlusion, ProfileGaussian, Skin, SpecularRegion, MAX_BLUR_WIDTH,

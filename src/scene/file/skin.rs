@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::medium::Medium;
 use super::{in_range, non_negative, positive};
 
 /// Blur kernel for the Gaussian chain.
@@ -98,6 +99,9 @@ pub struct Skin {
     /// behind it (translucent shadow maps, docs/skin.md "Transmission"; ≥ 0,
     /// 0: off).
     pub transmission: f32,
+    /// The medium the profile, the transmission and the specular follow
+    /// (`[skin.medium]`; default `deon2007`, no medium).
+    pub medium: Medium,
 }
 
 impl Default for Skin {
@@ -115,6 +119,7 @@ impl Default for Skin {
             blur_width: 1.0,
             blur_amount: 1.0,
             transmission: 1.0,
+            medium: Medium::default(),
         }
     }
 }
@@ -134,7 +139,15 @@ impl Skin {
         non_negative("skin.transmission", self.transmission)?;
         if let Some(profile) = &self.profile {
             validate_profile(profile)?;
+            if !self.medium.is_deon2007() {
+                return Err(
+                    "skin.profile and a skin.medium other than deon2007 both give \
+                            the profile: keep one"
+                        .into(),
+                );
+            }
         }
+        self.medium.validate()?;
         if let Some(regions) = &self.regions {
             validate_regions(regions)?;
         }

@@ -594,3 +594,54 @@ fn fuzzed_scene_text_never_panics() {
     println!("fuzzed scenes: {ok} accepted, {rejected} rejected");
     assert!(rejected > 0 && ok > 0);
 }
+
+#[test]
+fn a_medium_is_one_of_preset_coefficients_or_albedo_and_radius() {
+    let s = parse("[skin.medium]\npreset = \"jensen-skin1\"\n").unwrap();
+    assert_eq!(s.skin.medium.preset, Some(MediumPreset::JensenSkin1));
+    assert!(!s.skin.medium.is_deon2007());
+    assert!(SceneFile::default().skin.medium.is_deon2007());
+    let s =
+        parse("[skin.medium]\nsigma_a = [0.032, 0.17, 0.48]\nsigma_s_prime = [0.74, 0.88, 1.01]\n")
+            .unwrap();
+    assert_eq!(s.skin.medium.sigma_a, Some([0.032, 0.17, 0.48]));
+    parse("[skin.medium]\nalbedo = [0.8, 0.5, 0.3]\ndmfp = [3.6, 1.4, 0.7]\n").unwrap();
+    for (text, says) in [
+        (
+            "preset = \"jensen-skin1\"\nsigma_a = [1, 1, 1]\nsigma_s_prime = [1, 1, 1]",
+            "not several",
+        ),
+        ("sigma_a = [0.1, 0.1, 0.1]", "go together"),
+        (
+            "sigma_a = [0.1, -0.1, 0.1]\nsigma_s_prime = [1, 1, 1]",
+            "green value -0.1",
+        ),
+        (
+            "sigma_a = [0.1, 0.1, 0.1]\nsigma_s_prime = [1, 0, 1]",
+            "sigma_s_prime",
+        ),
+        (
+            "albedo = [0.8, 0.5, 0.3]",
+            "exactly one of `mfp` and `dmfp`",
+        ),
+        ("albedo = [0.8, 1.5, 0.3]\nmfp = [1, 1, 1]", "in (0, 1)"),
+        (
+            "albedo = [0.8, 0.5, 0.3]\nmfp = [1, 1, 1]\ndmfp = [1, 1, 1]",
+            "exactly one",
+        ),
+        ("dmfp = [1, 1, 1]", "needs `albedo`"),
+        ("preset = \"jensen-skin1\"\ninversion = \"dipole\"", "only"),
+        ("preset = \"jensen-skin1\"\ng = 1.0", "skin.medium.g"),
+        ("preset = \"jensen-skin1\"\nior = 0.5", "skin.medium.ior"),
+        ("specular = \"boundary\"", "needs a medium"),
+        ("preset = \"jensen-skin9\"", "jensen-skin9"),
+    ] {
+        let msg = err(&format!("[skin.medium]\n{text}\n"));
+        assert!(msg.contains(says), "{text}: {msg}");
+    }
+    let msg = err(
+        "[skin]\nprofile = [{ variance_mm2 = 1, weights = [1, 1, 1] }]\n\
+                   [skin.medium]\npreset = \"jensen-skin1\"\n",
+    );
+    assert!(msg.contains("keep one"), "{msg}");
+}

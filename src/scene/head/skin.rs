@@ -245,14 +245,7 @@ fn srgb_to_linear(c: Vec3) -> Vec3 {
 }
 
 pub(super) fn linear_to_srgb(c: Vec3) -> Vec3 {
-    c.map(|v| {
-        let v = v.clamp(0.0, 1.0);
-        if v <= 0.003_130_8 {
-            v * 12.92
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        }
-    })
+    c.map(crate::scene::texture::linear_to_srgb)
 }
 
 #[cfg(test)]
