@@ -91,13 +91,6 @@ pub struct MediumSkin {
     pub specular: SpecularRule,
 }
 
-/// ρs that makes the KS lobe a rough dielectric's reflection: KS is
-/// ρs·PH·F/(h·h) with d'Eon's PH = π·D (skin::specular::beckmann_ph) and
-/// h·h = 4(H·V)², so ρs = 1/π gives D·F/(4(H·V)²), the Cook–Torrance lobe with
-/// Kelemen & Szirmay-Kalos's G/(cos θi cos θo) ≈ 1/(H·V)² (skin::specular's
-/// tests hold its albedo against Smith's microfacet one).
-pub const BOUNDARY_RHO_S: f32 = 1.0 / std::f32::consts::PI;
-
 impl SkinSettings {
     pub fn resolve(skin: &Skin, render: &Render) -> Result<Self> {
         let medium = medium_skin(skin);
@@ -148,7 +141,7 @@ impl SkinSettings {
         });
         if medium.as_ref().is_some_and(MediumSkin::boundary_specular) {
             for r in &mut regions {
-                r.rho_s = BOUNDARY_RHO_S;
+                r.rho_s = specular::boundary_rho_s(r.m);
             }
         }
         Ok(Self {

@@ -294,31 +294,91 @@ pub fn radial(
 /// Channel `c`'s transmission through a slab `thickness` mm thick, lit from
 /// behind at normal incidence, from `photons` photons entering.
 pub fn slab(medium: &Medium, c: usize, thickness: f64, photons: usize) -> Slab {
+    let counts = slab_counts(medium, c, thickness, 0..photons.div_ceil(CHUNK));
+    counts.share()
+}
+
+/// The same, walking photons in growing batches until `scattered` of them
+/// have left scattered through the far side (relative noise 1/√`scattered`)
+/// or `max_photons` have entered.
+pub fn slab_to_count(
+    medium: &Medium,
+    c: usize,
+    thickness: f64,
+    scattered: u64,
+    max_photons: usize,
+) -> Slab {
+    let max_chunks = max_photons.div_ceil(CHUNK).max(1);
+    let mut total = SlabCounts::default();
+    let mut done = 0;
+    let mut batch = 4;
+    while done < max_chunks && total.scattered < scattered {
+        let next = (done + batch).min(max_chunks);
+        total.add(slab_counts(medium, c, thickness, done..next));
+        done = next;
+        batch *= 2;
+    }
+    total.share()
+}
+
+/// Photons counted by where they left a slab.
+#[derive(Clone, Copy, Debug, Default)]
+struct SlabCounts {
+    scattered: u64,
+    ballistic: u64,
+    reflected: u64,
+    entered: u64,
+}
+
+impl SlabCounts {
+    fn add(&mut self, o: SlabCounts) {
+        self.scattered += o.scattered;
+        self.ballistic += o.ballistic;
+        self.reflected += o.reflected;
+        self.entered += o.entered;
+    }
+
+    fn share(&self) -> Slab {
+        let n = self.entered.max(1) as f64;
+        Slab {
+            scattered: self.scattered as f64 / n,
+            ballistic: self.ballistic as f64 / n,
+            reflected: self.reflected as f64 / n,
+        }
+    }
+}
+
+/// The photons of chunks `chunks` (each seeded by its index).
+fn slab_counts(
+    medium: &Medium,
+    c: usize,
+    thickness: f64,
+    chunks: std::ops::Range<usize>,
+) -> SlabCounts {
     let ch = Channel::of(medium, c);
-    let chunks = photons.div_ceil(CHUNK);
     let seed = ((c as u64) << 40) ^ thickness.to_bits().rotate_left(7) ^ 0x51ab;
-    let (s, b, r) = (0..chunks)
+    chunks
         .into_par_iter()
         .map(|k| {
             let mut rng = Rng::new(seed ^ ((k as u64) << 20));
-            let (mut s, mut b, mut r) = (0u64, 0u64, 0u64);
+            let mut n = SlabCounts {
+                entered: CHUNK as u64,
+                ..SlabCounts::default()
+            };
             for _ in 0..CHUNK {
                 match walk(ch, [0.0, 0.0, 1.0], thickness, &mut rng) {
-                    End::Bottom { scattered: true } => s += 1,
-                    End::Bottom { scattered: false } => b += 1,
-                    End::Top(..) => r += 1,
+                    End::Bottom { scattered: true } => n.scattered += 1,
+                    End::Bottom { scattered: false } => n.ballistic += 1,
+                    End::Top(..) => n.reflected += 1,
                     End::Absorbed => {}
                 }
             }
-            (s, b, r)
+            n
         })
-        .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
-    let n = (chunks * CHUNK) as f64;
-    Slab {
-        scattered: s as f64 / n,
-        ballistic: b as f64 / n,
-        reflected: r as f64 / n,
-    }
+        .reduce(SlabCounts::default, |mut a, b| {
+            a.add(b);
+            a
+        })
 }
 
 #[cfg(test)]
