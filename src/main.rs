@@ -4,7 +4,7 @@
 mod cli;
 
 use clap::{Parser, Subcommand};
-use cli::{compare, inspect, reference, render, sweep, view, AFTER_HELP};
+use cli::{compare, inspect, medium, reference, render, sweep, view, AFTER_HELP};
 use dermis::gpu::ContextOptions;
 use std::process::ExitCode;
 
@@ -47,6 +47,12 @@ enum Command {
     /// Shares are fractions in --json. Runs on the CPU.
     #[command(after_help = AFTER_HELP)]
     Lights(inspect::LightsArgs),
+    /// Print the scene's skin medium (--medium, `[skin.medium]`): its
+    /// coefficients, albedo, the six Gaussians fitted to its R(r) with their
+    /// error, and its light through slabs (docs/media.md). Runs on the CPU;
+    /// the tables are cached.
+    #[command(after_help = AFTER_HELP)]
+    Medium(medium::MediumArgs),
     /// Compute (and cache) the per-vertex occlusion transfer, the specular's lobe visibility, and the interreflected and transmitted transfers ahead of rendering.
     ///
     /// The scene's mesh (--mesh, --mm-per-unit) and `skin.occlusion`
@@ -142,6 +148,7 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
         Command::Info(args) => inspect::info(args, &context),
         Command::Sh(args) => inspect::sh(args, &context),
         Command::Lights(args) => inspect::lights(args),
+        Command::Medium(args) => medium::medium(args),
         Command::Precompute(args) => render::precompute(args, &context),
         Command::Sweep(args) => sweep::sweep(args, &context),
         Command::Reference(args) => reference::reference(args, &context),

@@ -1133,3 +1133,32 @@ fn render_preroll_frames_are_rendered_but_not_reported() {
     assert!(numbers[1] > 1, "pre-roll frames come between: {numbers:?}");
     assert_eq!(numbers[2], numbers[1] + 1);
 }
+
+/// `dermis medium`: deon2007 prints the Gaussians' T(d) at the thicknesses
+/// asked, matching the CPU profile; bad thicknesses and media are refused with
+/// exit 2, naming the flag or key, before any walk.
+#[test]
+fn medium_prints_the_profiles_transmission_and_refuses_bad_input() {
+    let out = dermis(&["medium", "--medium", "deon2007", "--thickness", "1", "2"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let p = dermis::skin::profile::Profile::skin();
+    for d in [1.0f32, 2.0] {
+        let t = p.transmittance(d);
+        let line = format!(
+            "T({d} mm) = Σ wᵢ exp(−d²/2vᵢ) = {:.4} {:.4} {:.4}",
+            t.x, t.y, t.z
+        );
+        assert!(text.contains(&line), "{line:?} not in {text}");
+    }
+    let out = dermis(&["medium", "--thickness", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--thickness"));
+    let out = dermis(&["medium", "--medium", "jensen-skin9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--medium"));
+}
