@@ -64,7 +64,21 @@ pub fn search_path() -> Vec<PathBuf> {
 
 /// `<folder>/<relative>` for the first folder of [`search_path`] that holds it
 /// (absolute); else a message naming every folder searched.
+///
+/// `$DERMIS_ASSETS` set to something that is not a folder (a typo) is an error
+/// rather than a silent fallback on the other folders.
 pub fn find(relative: &str) -> Result<PathBuf, String> {
+    if let Some(d) = std::env::var_os(ASSETS_VAR).filter(|d| !d.is_empty()) {
+        let d = PathBuf::from(d);
+        if !d.is_dir() {
+            return Err(format!(
+                "{ASSETS_VAR}={} is not a folder: set it to the assets folder of a dermis \
+                 checkout, or unset it to search ./assets, beside the executable and the build's \
+                 checkout",
+                d.display()
+            ));
+        }
+    }
     find_in(&search_path(), relative)
 }
 

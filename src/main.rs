@@ -115,6 +115,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // First, before any thread: an interrupted write leaves no temporary.
+    dermis::atomic::clean_up_on_signals();
     let cli = Cli::parse();
     let level = match cli.verbose {
         0 => "warn",

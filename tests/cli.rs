@@ -310,6 +310,7 @@ fn bad_outputs_are_refused_before_the_device_is_opened() {
     let file = tmp("a-file.txt");
     std::fs::write(&file, "x").unwrap();
     let (folder, file) = (folder.to_str().unwrap(), file.to_str().unwrap());
+    let in_file = format!("{file}/r.json");
     let (sheet, shot, csv) = (tmp("sheet.exr"), tmp("shot.jpg"), tmp("c.txt"));
     let (sheet, shot, csv) = (
         sheet.to_str().unwrap(),
@@ -365,6 +366,25 @@ fn bad_outputs_are_refused_before_the_device_is_opened() {
             "--bencher",
             "is a folder",
         ),
+        // A trailing slash names a folder, for every output flag.
+        (vec!["render", "--out", "new.png/"], "--out", "is a folder"),
+        (
+            vec!["render", "--debug-sheet", "new.png/"],
+            "--debug-sheet",
+            "is a folder",
+        ),
+        (vec!["render", "--csv", "new.csv/"], "--csv", "is a folder"),
+        // A folder where nothing can be created; a file taken for a folder.
+        (
+            vec!["render", "--out", "/proc/x.png"],
+            "--out",
+            "cannot create a file in /proc",
+        ),
+        (
+            vec!["render", "--report", &in_file],
+            "--report",
+            "is not a folder",
+        ),
     ];
     for (args, flag, why) in cases {
         let path = args.last().copied().unwrap();
@@ -387,7 +407,7 @@ fn bad_outputs_are_refused_before_the_device_is_opened() {
         );
         assert!(!stderr.contains("no-such-gpu-xyz"), "{args:?}: {stderr}");
     }
-    for created in [sheet, shot, csv] {
+    for created in [sheet, shot, csv, "new.png", "new.csv"] {
         assert!(!std::path::Path::new(created).exists(), "{created}");
     }
     assert!(!std::path::Path::new("/no/such/dir").exists());
@@ -513,6 +533,110 @@ fn bad_post_and_blur_settings_name_their_key() {
         &["--debug-sheet", tmp("sheet.jpg").to_str().unwrap()],
         "unsupported output format",
     );
+}
+
+/// `export` refuses a report of a schema newer than it reads, as `compare`
+/// does, writing nothing.
+#[test]
+fn export_refuses_an_unknown_schema_version() {
+    let report = tmp("schema-99.json");
+    std::fs::write(&report, r#"{"schema_version": 99, "per_frame": []}"#).unwrap();
+    let bencher = tmp("bencher-99.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+        .args(["export", report.to_str().unwrap(), "--bencher"])
+        .arg(&bencher)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("schema-99.json: report schema 99 is newer than this dermis reads"),
+        "{stderr}"
+    );
+    assert!(!bencher.exists());
+}
+
+/// Two output flags naming one file would overwrite each other: refused
+/// before any work, also through a symbolic link.
+#[test]
+fn two_outputs_naming_one_file_are_refused() {
+    let c = tmp("one.png");
+    let link = tmp("link-to-one.png");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(&c, &link).unwrap();
+    let (c, link) = (c.to_str().unwrap(), link.to_str().unwrap());
+    for args in [
+        vec!["render", "--compare-occlusion", c, "--out", c],
+        vec!["render", "--out", c, "--debug-sheet", link],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+            .args(&args)
+            .args(["--device", "no-such-gpu-xyz"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("name one file"), "{args:?}: {stderr}");
+        assert!(!stderr.contains("no-such-gpu-xyz"), "{stderr}");
+    }
+}
+
+/// An exposure whose image cannot be represented (inf/NaN or zeros in the
+/// EXR) is refused naming the bound; a head off-screen says so.
+#[test]
+fn exposures_beyond_floats_are_refused_and_an_empty_frame_is_said() {
+    assert_bad_input(
+        &["--exposure", "200"],
+        "render.exposure = 200: must be in -100..=100 EV",
+    );
+    assert_bad_input(&["--exposure", "-200"], "render.exposure = -200");
+    // Too bright a source is named, with its radiance, not only the intensity.
+    assert_bad_input(
+        &["--env", "uniform:1e5,1e5,1e5"],
+        "environment uniform:100000,100000,100000 is too bright: its radiance reaches 1.0000e5",
+    );
+    for mm in ["1e-6", "1e6"] {
+        let out = dermis(&[
+            "render",
+            "--out",
+            tmp("off-screen.png").to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--irradiance-res",
+            "256",
+            "--mm-per-unit",
+            mm,
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{mm}: {stderr}");
+        assert!(
+            stderr.contains("warning: the mesh covers no pixel"),
+            "{mm}: {stderr}"
+        );
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("nothing covered to meter"),
+            "{mm}"
+        );
+    }
+    // A given exposure far too low: the image is black, and that is said.
+    let out = dermis(&[
+        "render",
+        "--out",
+        tmp("black.png").to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--irradiance-res",
+        "256",
+        "--exposure",
+        "-60",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("the image is black"), "{stderr}");
 }
 
 #[test]
@@ -726,6 +850,29 @@ fn sh_prints_the_projection_of_a_constant_sky() {
     assert_eq!(v["order"][1], "L1-1");
 }
 
+/// A lat-long map of 2×1 and 4×2 texels, constant: L00 alone (each texel's
+/// basis integrated over its cell; centre samples gave L20 = −3.96, L22 = 6.86).
+#[test]
+fn sh_of_a_tiny_constant_map_is_l00_alone() {
+    for (w, h) in [(2, 1), (4, 2)] {
+        let path = tmp(&format!("tiny-{w}x{h}.hdr"));
+        let img = image::Rgb32FImage::from_pixel(w, h, image::Rgb([1.0, 1.0, 1.0]));
+        img.save(&path).unwrap();
+        let out = dermis(&["sh", path.to_str().unwrap(), "--json"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{w}×{h}: {stderr}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let k = 2.0 * std::f64::consts::PI.sqrt();
+        for (name, c) in v["coefficients"].as_object().unwrap() {
+            let want = if name == "L00" { k } else { 0.0 };
+            for x in c.as_array().unwrap() {
+                let x = x.as_f64().unwrap();
+                assert!((x - want).abs() < 1e-4 * k, "{w}×{h}: {name} = {x}");
+            }
+        }
+    }
+}
+
 #[test]
 fn lights_prints_the_sun_of_the_sky() {
     // The built-in sky's sun: elevation 30°, azimuth 295°; --rotate 90 adds 90° of azimuth.
@@ -817,6 +964,18 @@ fn a_binary_outside_its_checkout_finds_assets_or_says_where_it_looked() {
     }
     assert!(stderr.contains("DERMIS_ASSETS"), "{stderr}");
 
+    // DERMIS_ASSETS naming no folder: said, not a silent fallback.
+    let out = run(
+        &["render", "--out", "e.png"],
+        Some(std::path::Path::new("/nonexistent/assets")),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("DERMIS_ASSETS=/nonexistent/assets is not a folder"),
+        "{stderr}"
+    );
+
     let json = dir.join("d.json");
     let assets = dermis::assets::dir();
     let out = run(
@@ -877,6 +1036,158 @@ fn precompute_fills_the_cache_and_reports_time() {
     assert_eq!(files(), 4, "and writes nothing new");
     let out = dermis(&["precompute", "--occlusion", "sideways"]);
     assert_eq!(out.status.code(), Some(2));
+    // A cache folder that cannot be written: refused before the work.
+    let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+        .args(["precompute", "--occlusion", "raytrace"])
+        .env("DERMIS_CACHE_DIR", "/proc/dermis-cache")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("/proc/dermis-cache") && stderr.contains("DERMIS_CACHE_DIR"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("vertices"), "{stderr}");
+}
+
+/// `dermis … | head -1`: the reader goes away, dermis finishes its work
+/// (every file whole), prints nothing more and exits 0, without a panic.
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    let cache = tmp("pipe-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let png = tmp("pipe.png");
+    let exe = env!("CARGO_BIN_EXE_dermis");
+    for (cmd, files) in [
+        (format!("'{exe}' precompute --occlusion raytrace"), 4usize),
+        (
+            format!(
+                "'{exe}' render --timings --dump-graph --width 32 --height 32 \
+                 --irradiance-res 256 --out '{}'",
+                png.display()
+            ),
+            0,
+        ),
+    ] {
+        let out = Command::new("bash")
+            .arg("-c")
+            .arg(format!(
+                "{cmd} | head -1; echo \"status ${{PIPESTATUS[0]}}\" >&2"
+            ))
+            .env("DERMIS_CACHE_DIR", &cache)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("status 0"), "{cmd}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{cmd}: {stderr}");
+        assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1);
+        if files > 0 {
+            assert_eq!(std::fs::read_dir(&cache).unwrap().count(), files);
+        }
+    }
+    assert!(image::open(&png).is_ok());
+}
+
+/// Paths that are not UTF-8 are written (and the report's command line
+/// carries them lossily), not a panic after the work.
+#[test]
+fn paths_that_are_not_utf8_are_written() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tmp("non-utf8");
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join(std::ffi::OsStr::from_bytes(b"o\xff.png"));
+    let json = dir.join(std::ffi::OsStr::from_bytes(b"r\xff.json"));
+    let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
+        .args([
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--irradiance-res",
+            "256",
+        ])
+        .arg("--out")
+        .arg(&png)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(png.is_file() && json.is_file());
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let line = report["command_line"].to_string();
+    assert!(line.contains("o\u{fffd}.png"), "{line}");
+}
+
+/// Interrupted (INT, TERM) while a temporary is written: it is removed and
+/// the process dies of the signal. Killed outright (KILL), its temporary is
+/// removed by the next write into that folder.
+#[test]
+fn an_interrupted_write_leaves_no_temporary() {
+    use std::os::unix::process::ExitStatusExt;
+    let names = |d: &std::path::Path| -> Vec<String> {
+        let mut n: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        n.sort();
+        n
+    };
+    let render = |dir: &std::path::Path, name: &str, pause: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_dermis"));
+        c.args([
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--irradiance-res",
+            "256",
+        ])
+        .arg("--out")
+        .arg(dir.join(name))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null());
+        if pause {
+            c.env(dermis::atomic::TEST_PAUSE_VAR, "60000");
+        }
+        c
+    };
+    // Until the temporary of `x.png` is there (the write is paused on it).
+    let wait_for_temporary = |dir: &std::path::Path| {
+        let started = std::time::Instant::now();
+        while !names(dir).iter().any(|n| n.starts_with(".x.tmp-")) {
+            assert!(started.elapsed().as_secs() < 300, "no temporary appeared");
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+    };
+    for (signal, number) in [("INT", 2), ("TERM", 15), ("KILL", 9)] {
+        let dir = tmp(&format!("interrupted-{signal}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut child = render(&dir, "x.png", true).spawn().unwrap();
+        wait_for_temporary(&dir);
+        let killed = Command::new("kill")
+            .args(["-s", signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.signal(), Some(number), "{signal}: {status:?}");
+        if signal == "KILL" {
+            // Left behind, then swept by the next write into the folder.
+            assert_eq!(names(&dir).len(), 1, "{:?}", names(&dir));
+            let out = render(&dir, "y.png", false).output().unwrap();
+            assert!(out.status.success());
+            assert_eq!(names(&dir), ["y.png"]);
+        } else {
+            assert!(names(&dir).is_empty(), "{signal}: {:?}", names(&dir));
+        }
+    }
 }
 
 #[test]

@@ -14,6 +14,7 @@ const SHARD_ENV: &[&str] = &[
     "DERMIS_SHARD_TOTAL",
     "SLURM_ARRAY_TASK_ID",
     "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_MAX",
     "SLURM_ARRAY_TASK_STEP",
     "SLURM_ARRAY_TASK_COUNT",
     "JOB_COMPLETION_INDEX",
@@ -375,6 +376,26 @@ fn shard_auto_reads_the_scheduler_and_bad_shards_exit_2() {
     let list: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(ids(&list), ["r256-deon7-full"]);
 
+    // An irregular list (--array=1,4,9) is refused before any work, saying why.
+    let irregular = [
+        ("SLURM_ARRAY_TASK_ID", "4"),
+        ("SLURM_ARRAY_TASK_MIN", "1"),
+        ("SLURM_ARRAY_TASK_MAX", "9"),
+        ("SLURM_ARRAY_TASK_STEP", "1"),
+        ("SLURM_ARRAY_TASK_COUNT", "3"),
+    ];
+    let out = dermis(
+        &with(&["--shard", "auto", "--out-dir", "/nonexistent/x"]),
+        &irregular,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("not a regular range") && stderr.contains("MAX=9"),
+        "{stderr}"
+    );
+    assert!(!Path::new("/nonexistent/x").exists());
+
     for bad in ["0/3", "4/3", "x/y", "1/0", "auto"] {
         let out = dermis(&with(&["--shard", bad, "--out-dir", "/nonexistent/x"]), &[]);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -383,4 +404,150 @@ fn shard_auto_reads_the_scheduler_and_bad_shards_exit_2() {
     }
     let out = dermis(&["sweep", "merge", "/nonexistent/shards"], &[]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// docs/recipes/slurm-sweep.sh with `sbatch` and `sinfo` stubbed (no Slurm
+/// here): the launcher sizes the tasks to the smallest node, makes the merge
+/// cancellable, retries one shard with --resume; the task part gives dermis
+/// its shard of SHARDS even when the array is that one index.
+#[test]
+fn the_slurm_recipe_submits_and_retries_shards() {
+    let dir = tmp("slurm-recipe");
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let calls = dir.join("sbatch-calls");
+    let stub = |name: &str, body: &str| {
+        let path = bin.join(name);
+        std::fs::write(&path, format!("#!/bin/bash\n{body}\n")).unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    };
+    stub(
+        "sbatch",
+        &format!(
+            "echo \"$* | SWEEP_ARGS=$SWEEP_ARGS\" >> '{}'; echo 4242",
+            calls.display()
+        ),
+    );
+    stub("sinfo", "printf '2\\n16\\n'");
+    let recipe = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/recipes/slurm-sweep.sh");
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let launch = |args: &[&str]| {
+        let mut c = Command::new("bash");
+        c.arg(&recipe).args(args).env("PATH", &path);
+        for k in SHARD_ENV
+            .iter()
+            .chain(&["CPUS", "SHARDS", "SWEEP_ARGS", "OUT"])
+        {
+            c.env_remove(k);
+        }
+        c.env("OUT", dir.join("out")).output().unwrap()
+    };
+    let out = launch(&[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = launch(&["2"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("shards 2 of 3"));
+    let bad = launch(&["4"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let text = std::fs::read_to_string(&calls).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "{text}");
+    // The array: all shards, sized to the 2-CPU node; the merge after it.
+    assert!(
+        lines[0].contains("--array=1-3")
+            && lines[0].contains("--cpus-per-task=2")
+            && !lines[0].contains("--resume"),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].contains("--dependency=afterok:4242")
+            && lines[1].contains("--kill-on-invalid-dep=yes")
+            && lines[1].contains("sweep merge"),
+        "{}",
+        lines[1]
+    );
+    // The retry: shard 2 alone, resumed, and a merge of its own.
+    assert!(
+        lines[2].contains("--array=2 ") && lines[2].contains("SWEEP_ARGS=--frames 4 --resume"),
+        "{}",
+        lines[2]
+    );
+    assert!(
+        lines[3].contains("--kill-on-invalid-dep=yes"),
+        "{}",
+        lines[3]
+    );
+
+    // The retried task as Slurm runs it (--array=2: MIN = MAX = 2, COUNT 1).
+    let args = with(&["--list-points", "--json"])[1..].join(" ");
+    let out = Command::new("bash")
+        .arg(&recipe)
+        .env("DERMIS", env!("CARGO_BIN_EXE_dermis"))
+        .env("OUT", dir.join("out"))
+        .env("SWEEP_ARGS", &args)
+        .env_remove("DERMIS_SHARD")
+        .env_remove("DERMIS_SHARD_TOTAL")
+        .env_remove("SHARDS")
+        .envs([
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_MIN", "2"),
+            ("SLURM_ARRAY_TASK_MAX", "2"),
+            ("SLURM_ARRAY_TASK_STEP", "1"),
+            ("SLURM_ARRAY_TASK_COUNT", "1"),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("shard 2/3 by id hash"), "{stderr}");
+    let list: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(list["shard"], "hash:2/3");
+}
+
+/// Two sweeps into one --out-dir at once: the second is refused before any
+/// work (the first holds its log's lock), the first's log stays whole. The
+/// folder's name is not UTF-8 (a panic once, after the work).
+#[test]
+fn a_second_sweep_into_one_folder_is_refused() {
+    use std::os::unix::ffi::OsStrExt;
+    let out_dir = tmp("concurrent").join(OsStr::from_bytes(b"sw\xff"));
+    let mut args: Vec<std::ffi::OsString> =
+        with(&["--out-dir"]).into_iter().map(Into::into).collect();
+    args.push(out_dir.clone().into());
+    let first = spawn(&args);
+    let log = out_dir.join("points.jsonl");
+    let started = std::time::Instant::now();
+    while !log.exists() {
+        assert!(
+            started.elapsed().as_secs() < 300,
+            "the first sweep never started"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let second = dermis(&args, &[]);
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("another dermis sweep"), "{stderr}");
+    let first = first.wait_with_output().unwrap();
+    check("the first sweep", &first);
+    let records: Vec<String> = lines(&log)
+        .iter()
+        .map(|l| l["record"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(records, ["header", "point", "point"]);
+    assert!(out_dir.join("sweep.json").is_file());
 }

@@ -8,7 +8,7 @@ use clap::Args;
 use dermis::profile::compare::{self, Comparison, Measurement};
 use dermis::sweep::compare::{self as input, Side};
 
-use super::{check_out_dir, check_output, read_text, to_json, write_file};
+use super::{check_distinct, check_out_dir, check_output, read_text, to_json, write_file};
 
 /// How `compare` and `interleave` decide and what they write.
 #[derive(Args)]
@@ -170,13 +170,17 @@ pub fn export(args: ExportArgs) -> dermis::Result<()> {
             check_output(flag, path, &["json"])?;
         }
     }
+    check_distinct(&[
+        ("--github-benchmark", args.github_benchmark.as_deref()),
+        ("--bencher", args.bencher.as_deref()),
+    ])?;
     let text = read_text(&args.report)?;
-    let r: dermis::profile::RunReport = serde_json::from_str(&text).map_err(|e| {
-        dermis::Error::Input(format!(
-            "{}: not a dermis run report: {e}",
-            args.report.display()
-        ))
-    })?;
+    let source = args.report.display().to_string();
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| dermis::Error::Input(format!("{source}: not JSON: {e}")))?;
+    dermis::profile::compare::check_report_schema(&value, &source)?;
+    let r: dermis::profile::RunReport = serde_json::from_value(value)
+        .map_err(|e| dermis::Error::Input(format!("{source}: not a dermis run report: {e}")))?;
     if let Some(path) = args.github_benchmark {
         let v = dermis::profile::export::github_benchmark(&r);
         write_file(&path, &to_json(&path, &v)?)?;
@@ -193,7 +197,7 @@ pub fn export(args: ExportArgs) -> dermis::Result<()> {
 /// `dermis report-schema`.
 pub fn report_schema() -> dermis::Result<()> {
     let schema = schemars::schema_for!(dermis::profile::RunReport);
-    println!("{}", to_json(Path::new("stdout"), &schema)?);
+    outln!("{}", to_json(Path::new("stdout"), &schema)?);
     Ok(())
 }
 
@@ -237,18 +241,18 @@ fn report_comparison(
             }))
         }
         .map_err(|e| dermis::Error::Input(e.to_string()))?;
-        println!("{}", to_json(Path::new("stdout"), &value)?);
+        outln!("{}", to_json(Path::new("stdout"), &value)?);
     } else {
         if !single {
             for w in &warnings {
-                println!("warning: {w}");
+                outln!("warning: {w}");
             }
         }
         for (label, c) in &results {
             if !label.is_empty() {
-                println!("\n== point {label}");
+                outln!("\n== point {label}");
             }
-            print!("{}", compare::table(c));
+            out!("{}", compare::table(c));
         }
     }
     let comparisons: Vec<&Comparison> = results.iter().map(|(_, c)| c).collect();

@@ -92,24 +92,25 @@ pub fn info(args: InfoArgs, context: &ContextOptions) -> dermis::Result<()> {
     let ctx = Context::new(context)?;
     let info = &ctx.info;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(info).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(info).unwrap_or_default());
         return Ok(());
     }
-    println!("device:            {} ({})", info.name, info.device_type);
-    println!(
+    outln!("device:            {} ({})", info.name, info.device_type);
+    outln!(
         "driver:            {} {}",
-        info.driver_name, info.driver_info
+        info.driver_name,
+        info.driver_info
     );
-    println!("Vulkan:            {}", info.api_version);
-    println!(
+    outln!("Vulkan:            {}", info.api_version);
+    outln!(
         "timestamps:        {} (period {} ns, {} valid bits)",
         if info.timestamps { "yes" } else { "no" },
         info.timestamp_period_ns,
         info.timestamp_valid_bits
     );
-    println!("max image size:    {}", info.max_image_dimension_2d);
+    outln!("max image size:    {}", info.max_image_dimension_2d);
     for (i, h) in info.memory_heaps.iter().enumerate() {
-        println!(
+        outln!(
             "memory heap {i}:     {:.1} GiB{}",
             h.size_bytes as f64 / (1u64 << 30) as f64,
             if h.device_local {
@@ -142,10 +143,10 @@ pub fn sh(args: ShArgs, context: &ContextOptions) -> dermis::Result<()> {
             "order": names,
             "coefficients": obj,
         });
-        println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
     } else {
         for (n, c) in names.iter().zip(&coeffs) {
-            println!("{n:<5} {:>14.6} {:>14.6} {:>14.6}", c.x, c.y, c.z);
+            outln!("{n:<5} {:>14.6} {:>14.6} {:>14.6}", c.x, c.y, c.z);
         }
     }
     if args.timings {
@@ -195,16 +196,16 @@ pub fn lights(args: LightsArgs) -> dermis::Result<()> {
             "lights": lights_json,
             "residual_share": residual,
         });
-        println!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(&out).unwrap_or_default());
         return Ok(());
     }
-    println!(
+    outln!(
         "{}, rotated {rotate}°, lights {lights}: {} found",
         env.env.text,
         rows.len()
     );
     if !rows.is_empty() {
-        println!(
+        outln!(
             "{:>2} {:>9} {:>8}  {:<24}  {:>11} {:>7}  {:<30}  {:>7}",
             "#",
             "elevation",
@@ -217,7 +218,7 @@ pub fn lights(args: LightsArgs) -> dermis::Result<()> {
         );
     }
     for (i, (l, d, elevation, azimuth)) in rows.iter().enumerate() {
-        println!(
+        outln!(
             "{:>2} {:>8.2}° {:>7.2}°  ({:>6.3}, {:>6.3}, {:>6.3})  {:>8.5} sr {:>6.2}°  \
              ({:>8.4}, {:>8.4}, {:>8.4})  {:>5.1} %",
             i + 1,
@@ -234,6 +235,6 @@ pub fn lights(args: LightsArgs) -> dermis::Result<()> {
             100.0 * l.share
         );
     }
-    println!("residual: {:.1} % of the energy", 100.0 * residual);
+    outln!("residual: {:.1} % of the energy", 100.0 * residual);
     Ok(())
 }

@@ -131,9 +131,9 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
         }
     })?;
     if json {
-        println!("{}", to_json(Path::new("stdout"), &rows)?);
+        outln!("{}", to_json(Path::new("stdout"), &rows)?);
     } else {
-        print!("{}", lighting::table(&rows));
+        out!("{}", lighting::table(&rows));
     }
     Ok(())
 }
@@ -174,9 +174,9 @@ fn diffusion(
         })?);
     }
     if json {
-        println!("{}", to_json(Path::new("stdout"), &rows)?);
+        outln!("{}", to_json(Path::new("stdout"), &rows)?);
     } else {
-        print!("{}", d::table(&rows));
+        out!("{}", d::table(&rows));
     }
     Ok(())
 }

@@ -9,7 +9,7 @@ use dermis::render::output::{write_sheet, Format};
 use dermis::render::{compare_occlusion, debug_sheet, render_scene, RenderOptions, View};
 use dermis::scene::{Overrides, Scene, SceneArg};
 
-use super::{check_output, to_json, write_file};
+use super::{check_distinct, check_output, to_json, write_file};
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -98,6 +98,14 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
             check_output(flag, path, exts)?;
         }
     }
+    check_distinct(&[
+        ("--out", Some(&args.out)),
+        ("--debug-sheet", args.debug_sheet.as_deref()),
+        ("--compare-occlusion", args.compare_occlusion.as_deref()),
+        ("--report", args.report.as_deref()),
+        ("--trace", args.trace.as_deref()),
+        ("--csv", args.csv.as_deref()),
+    ])?;
     let file = args.scene.file()?;
     let hdr = Format::of(&args.out)? == Format::Exr;
     let opts = RenderOptions {
@@ -116,15 +124,18 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
     let ctx = Context::new(context)?;
     if opts.view.name() == "list" {
         for name in dermis::render::views(&ctx, &loaded)? {
-            println!("{name}");
+            outln!("{name}");
         }
         return Ok(());
     }
     let output = render_scene(&ctx, &loaded, &opts)?;
     if args.dump_graph {
-        print!("{}", output.plan);
+        out!("{}", output.plan);
     }
     dermis::render::output::write(&args.out, &output)?;
+    for w in dermis::render::output::warnings(&output) {
+        eprintln!("warning: {w}");
+    }
     if let Some(r) = &output.reference {
         eprintln!(
             "{}reference: {} mesh pixels, {:.1} % converged to 0.5 %, mean standard error \
@@ -149,7 +160,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         eprintln!("{w}");
     }
     if args.timings {
-        print!("{}{}", r.header(), r.table());
+        out!("{}{}", r.header(), r.table());
     }
     if let Some(path) = args.report {
         write_file(&path, &to_json(&path, r)?)?;
@@ -160,23 +171,23 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
     if let Some(path) = args.csv {
         write_file(&path, &dermis::profile::csv::csv(r))?;
     }
-    println!(
+    outln!(
         "wrote {} (exposure {:+.2} EV, {})",
         args.out.display(),
         output.exposure,
-        if output.metered.is_some() {
-            "metered"
-        } else {
-            "given"
+        match output.metered {
+            Some(m) if m.pixels == 0 => "nothing covered to meter",
+            Some(_) => "metered",
+            None => "given",
         }
     );
     if let Some(path) = args.debug_sheet {
         write_sheet(&path, &debug_sheet(&ctx, &loaded, &opts)?)?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     if let Some(path) = args.compare_occlusion {
         write_sheet(&path, &compare_occlusion(&ctx, &loaded, &opts)?)?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -186,11 +197,22 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
     let file = args.scene.load(&args.overrides)?;
     let scene = dermis::skin::with_medium_albedo(dermis::scene::Scene::load(file)?);
     let (mesh, skin) = (&scene.mesh, &scene.file.skin);
+    // The cache is the point: a folder that cannot hold it fails before the work.
+    let cache = dermis::light::occlusion::default_cache_dir();
+    std::fs::create_dir_all(&cache)
+        .and_then(|()| dermis::atomic::probe(&cache.join("probe")))
+        .map_err(|e| {
+            dermis::Error::Input(format!(
+                "precompute: cannot write the cache folder {} ({e}); set DERMIS_CACHE_DIR to \
+                 a writable folder",
+                cache.display()
+            ))
+        })?;
     let ctx = Context::new(context)?;
     let started = std::time::Instant::now();
     let t = dermis::light::occlusion::transfer_for(&ctx, mesh, skin.occlusion)?;
     let secs = started.elapsed().as_secs_f64();
-    println!(
+    outln!(
         "{} vertices, occlusion {:?}: {:.2} s ({:.1} µs per vertex), cache {}",
         t.coeffs.len(),
         skin.occlusion,
@@ -200,14 +222,14 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
     );
     let started = std::time::Instant::now();
     dermis::light::occlusion::lobe_visibility_for(mesh, skin.occlusion);
-    println!(
+    outln!(
         "specular occlusion (lobe visibility): {:.2} s",
         started.elapsed().as_secs_f64()
     );
     if skin.interreflection {
         let started = std::time::Instant::now();
         dermis::light::interreflection::bounce_for(mesh, &scene.albedo, &t, skin.occlusion);
-        println!("interreflection: {:.2} s", started.elapsed().as_secs_f64());
+        outln!("interreflection: {:.2} s", started.elapsed().as_secs_f64());
     }
     let settings = dermis::skin::SkinSettings::resolve(skin, &scene.file.render)?;
     let started = std::time::Instant::now();
@@ -218,9 +240,15 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
         &settings.profile,
         settings.transmission,
     );
-    println!(
+    outln!(
         "environment transmission: {:.2} s",
         started.elapsed().as_secs_f64()
     );
-    Ok(())
+    match dermis::light::occlusion::store_failures() {
+        0 => Ok(()),
+        n => Err(dermis::Error::Input(format!(
+            "precompute: {n} of the transfers could not be cached in {} (warnings above)",
+            cache.display()
+        ))),
+    }
 }

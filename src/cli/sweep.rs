@@ -114,7 +114,7 @@ pub fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
     if args.replot {
         let sweep = sw::load(&args.out_dir.join("sweep.json"))?;
         output::write_csv_and_plots(&sweep, &args.out_dir)?;
-        println!("redrew {}", args.out_dir.display());
+        outln!("redrew {}", args.out_dir.display());
         return Ok(());
     }
     // What the sweep sets itself (hidden from its help).
@@ -168,23 +168,25 @@ pub fn sweep(args: SweepArgs, context: &ContextOptions) -> dermis::Result<()> {
         source,
     })?;
     let log = out_dir.join(shard.map_or_else(|| "points.jsonl".into(), |s| s.file_name()));
+    // Held to the end: a second sweep into this log is refused.
+    let _lock = sw::log::Lock::acquire(&log)?;
     let ctx = Context::new(context)?;
-    println!("{}", sw::TABLE_HEADER);
+    outln!("{}", sw::TABLE_HEADER);
     let how = sw::RunOptions {
         shard,
         log: Some(log.clone()),
         resume: args.resume,
     };
-    let sweep = sw::run(&ctx, &opts, &how, |p| println!("{}", sw::table_row(p)))?;
+    let sweep = sw::run(&ctx, &opts, &how, |p| outln!("{}", sw::table_row(p)))?;
     if shard.is_some() {
-        println!(
+        outln!(
             "wrote {} ({} points); merge the shards with `dermis sweep merge`",
             log.display(),
             sweep.points.len()
         );
     } else {
         output::write_all(&sweep, &out_dir)?;
-        println!("wrote {}", out_dir.display());
+        outln!("wrote {}", out_dir.display());
     }
     Ok(())
 }
@@ -197,13 +199,13 @@ fn list_points(
 ) -> dermis::Result<()> {
     let list = sw::points::list(opts, shard);
     if json {
-        println!("{}", to_json(Path::new("stdout"), &list)?);
+        outln!("{}", to_json(Path::new("stdout"), &list)?);
         return Ok(());
     }
     for p in &list.points {
-        println!("{}", p.id);
+        outln!("{}", p.id);
     }
-    println!(
+    outln!(
         "sweep hash {} ({} points)",
         list.sweep_hash,
         list.points.len()
@@ -229,7 +231,7 @@ fn merge(args: MergeArgs) -> dermis::Result<()> {
         .out_dir
         .unwrap_or_else(|| sw::merge::default_out_dir(&args.inputs));
     output::write_all(&merged.sweep, &out_dir)?;
-    println!(
+    outln!(
         "merged {} points from {} run(s) into {}",
         merged.sweep.points.len(),
         merged.sweep.shards.len(),

@@ -66,6 +66,24 @@ pub struct MeasuredFrame {
     pub passes: BTreeMap<String, f64>,
 }
 
+/// Refuses what is not a run report this dermis reads: no `schema_version`
+/// (older than schema 2, or not a report), or a newer one than
+/// [`SCHEMA_VERSION`].
+pub fn check_report_schema(value: &serde_json::Value, source: &str) -> Result<()> {
+    match value.get("schema_version").and_then(|v| v.as_u64()) {
+        Some(v) if v > u64::from(SCHEMA_VERSION) => Err(Error::Input(format!(
+            "{source}: report schema {v} is newer than this dermis reads ({SCHEMA_VERSION})"
+        ))),
+        None if value.get("per_frame").is_some() => Err(Error::Input(format!(
+            "{source}: a report older than schema 2 (no fingerprint): render it again"
+        ))),
+        None => Err(Error::Input(format!(
+            "{source}: not a dermis run report (no schema_version)"
+        ))),
+        Some(_) => Ok(()),
+    }
+}
+
 impl Measurement {
     /// The measured frames of a run report (schema 2 or later).
     pub fn from_report(report: &RunReport, source: &str) -> Result<Self> {
@@ -101,25 +119,7 @@ impl Measurement {
     pub fn from_report_json(text: &str, source: &str) -> Result<Self> {
         let value: serde_json::Value = serde_json::from_str(text)
             .map_err(|e| Error::Input(format!("{source}: not JSON: {e}")))?;
-        let version = value.get("schema_version").and_then(|v| v.as_u64());
-        match version {
-            Some(v) if v > u64::from(SCHEMA_VERSION) => {
-                return Err(Error::Input(format!(
-                    "{source}: report schema {v} is newer than this dermis reads ({SCHEMA_VERSION})"
-                )))
-            }
-            None if value.get("per_frame").is_some() => {
-                return Err(Error::Input(format!(
-                    "{source}: a report older than schema 2 (no fingerprint): render it again"
-                )))
-            }
-            None => {
-                return Err(Error::Input(format!(
-                    "{source}: not a dermis run report (no schema_version)"
-                )))
-            }
-            _ => {}
-        }
+        check_report_schema(&value, source)?;
         let report: RunReport = serde_json::from_value(value)
             .map_err(|e| Error::Input(format!("{source}: not a dermis run report: {e}")))?;
         Self::from_report(&report, source)

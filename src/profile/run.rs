@@ -297,7 +297,9 @@ impl RunReport {
             git_dirty: GIT_DIRTY,
             run_id: run_id(),
             timestamp: timestamp(),
-            command_line: std::env::args().collect(),
+            command_line: std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect(),
             setup,
             fingerprint,
             width,

@@ -54,6 +54,65 @@ pub fn write(path: &Path, out: &RenderOutput) -> Result<()> {
     }
 }
 
+/// What an exposed view's image fails to show, said rather than written
+/// silently: the mesh covering no pixel (off-screen: a wrong `mm_per_unit`,
+/// camera or size; the metered exposure is then of nothing), or the image one
+/// flat black or white wherever the mesh is (a given exposure far off).
+pub fn warnings(out: &RenderOutput) -> Vec<String> {
+    use super::view::Shown;
+    if out.view.shown() != Shown::Exposed || out.view.uv_space() {
+        return Vec::new();
+    }
+    let covered = match (&out.metered, &out.hdr) {
+        (Some(m), _) => Some(m.pixels > 0),
+        (None, Some(hdr)) => Some(
+            hdr.chunks_exact(4)
+                .any(|p| p[3] > crate::post::meter::COVERED),
+        ),
+        _ => None,
+    };
+    if covered == Some(false) {
+        return vec![format!(
+            "the mesh covers no pixel of the {}×{} image (off-screen or too small: check \
+             mesh.mm_per_unit, the camera and the size){}",
+            out.width,
+            out.height,
+            if out.metered.is_some() {
+                "; there was nothing to meter the exposure on"
+            } else {
+                ""
+            }
+        )];
+    }
+    let (mut black, mut white, mut n) = (0usize, 0usize, 0usize);
+    for p in out.rgba8.chunks_exact(4).filter(|p| p[3] > 127) {
+        n += 1;
+        black += usize::from(p[..3] == [0, 0, 0]);
+        white += usize::from(p[..3] == [255, 255, 255]);
+    }
+    let flat = match n {
+        0 => None,
+        _ if black == n => Some("black"),
+        _ if white == n => Some("white"),
+        _ => None,
+    };
+    flat.map(|flat| {
+        format!(
+            "the image is {flat} wherever it is covered, at exposure {:+.2} EV ({}): the \
+             exposure is far from the scene's light (without --exposure / render.exposure it is \
+             metered)",
+            out.exposure,
+            if out.metered.is_some() {
+                "metered"
+            } else {
+                "given"
+            }
+        )
+    })
+    .into_iter()
+    .collect()
+}
+
 /// A debug sheet or comparison (render::sheet), as PNG.
 pub fn write_sheet(path: &Path, sheet: &Sheet) -> Result<()> {
     if Format::of(path)? != Format::Png {

@@ -113,9 +113,17 @@ pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> R
     let largest = if intensity * env_irradiance >= from_lights {
         let rest = budget - from_lights;
         format!(
-            "environment.intensity = {intensity} (the map gives at most {} of irradiance): at most {} works",
+            "environment {} is too bright: its radiance reaches {} and gives at most {} of \
+             irradiance, × environment.intensity = {intensity}; at most environment.intensity \
+             = {} works with it (or a source {}× as bright)",
+            file.environment.source,
+            fmt(peak),
             fmt(env_irradiance),
-            fmt(rest / env_irradiance)
+            fmt(rest / env_irradiance),
+            match rest / (intensity * env_irradiance) {
+                r if r >= 1e-3 => format!("{r:.3}"),
+                r => format!("{:.3e}", r.max(0.0)),
+            }
         )
     } else {
         let (i, own) =
@@ -178,7 +186,11 @@ mod tests {
         file.environment.intensity = 3e4;
         let e = check(&file, &env, &sun, &mesh).unwrap_err();
         assert!(
-            e.starts_with("environment.intensity = 30000") && e.contains("at most 1.03"),
+            e.starts_with("environment sky:")
+                && e.contains("is too bright")
+                && e.contains("or a source 0.344× as bright")
+                && e.contains("environment.intensity = 30000")
+                && e.contains("at most environment.intensity = 1.03"),
             "{e}"
         );
         file.environment.intensity = 1.0;

@@ -116,7 +116,10 @@ fn decode_texture(bytes: &[u8], encoding: Encoding) -> Result<Texture, String> {
     let format = reader.format();
     match format {
         Some(ImageFormat::Png) => check_png_complete(bytes)?,
-        Some(ImageFormat::Jpeg) => check_jpeg_complete(bytes)?,
+        Some(ImageFormat::Jpeg) => {
+            check_jpeg_complete(bytes)?;
+            return decode_jpeg_strict(bytes, encoding);
+        }
         _ => return Err("not a PNG or JPEG image".into()),
     }
     let mut decoder = reader
@@ -149,6 +152,54 @@ fn decode_texture(bytes: &[u8], encoding: Encoding) -> Result<Texture, String> {
         height,
         encoding,
         rgba8: rgba.into_raw(),
+    })
+}
+
+/// Decodes a JPEG as RGBA8 with zune-jpeg in strict mode: a bad Huffman code,
+/// a scan ending early or a marker where none belongs is an error (the `image`
+/// crate's lenient mode fills such an image with grey or garbage silently, as
+/// a browser would; libjpeg calls them corrupt).
+fn decode_jpeg_strict(bytes: &[u8], encoding: Encoding) -> Result<Texture, String> {
+    use zune_core::bytestream::ZCursor;
+    use zune_core::colorspace::ColorSpace;
+    use zune_core::options::DecoderOptions;
+    let options = DecoderOptions::default()
+        .set_strict_mode(true)
+        .set_max_width(usize::MAX)
+        .set_max_height(usize::MAX)
+        .jpeg_set_out_colorspace(ColorSpace::RGBA);
+    let corrupt = |e: zune_jpeg::errors::DecodeErrors| {
+        format!("corrupt JPEG: {e}")
+            .replace('\n', " ")
+            .trim_end()
+            .to_string()
+    };
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    decoder.decode_headers().map_err(corrupt)?;
+    let (width, height) = decoder
+        .dimensions()
+        .ok_or("corrupt JPEG: no frame header")?;
+    let (width, height) = (width as u32, height as u32);
+    if width == 0 || height == 0 {
+        return Err(format!("image is {width} x {height}; it must not be empty"));
+    }
+    if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+        return Err(format!(
+            "image is {width} x {height}; the limit is {MAX_TEXTURE_SIZE} per side"
+        ));
+    }
+    let pixels = decoder.decode().map_err(corrupt)?;
+    if pixels.len() != 4 * width as usize * height as usize {
+        return Err(format!(
+            "corrupt JPEG: {} bytes decoded for {width} x {height} RGBA",
+            pixels.len()
+        ));
+    }
+    Ok(Texture {
+        width,
+        height,
+        encoding,
+        rgba8: pixels,
     })
 }
 
@@ -423,6 +474,69 @@ mod tests {
             assert!(!msg.contains('\n'), "{msg}");
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Bytes of the scan's entropy-coded data changed (not truncated): a lenient
+    /// decoder renders them as garbage blocks silently. Strict decoding refuses
+    /// every change it can detect: a run of one bits (stuffed FF 00 pairs) is
+    /// no Huffman code of any table, so it is always refused; random bytes
+    /// mostly still decode as valid (different) codes, which no decoder can
+    /// tell from data (libjpeg only counts bytes left over at the end).
+    #[test]
+    fn corrupt_jpeg_scans_are_refused() {
+        let jpg = std::fs::read(assets().join("Map-COL.jpg")).unwrap();
+        let original = decode_texture(&jpg, Encoding::Srgb).unwrap();
+        // The first SOS segment's data: after FF DA and its length.
+        let sos = jpg.windows(2).position(|w| w == [0xFF, 0xDA]).unwrap();
+        let data = sos + 2 + usize::from(u16::from_be_bytes([jpg[sos + 2], jpg[sos + 3]]));
+        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            rng
+        };
+        for _ in 0..20 {
+            let mut bytes = jpg.clone();
+            let at = data + 64 + (next() as usize) % 8192;
+            for pair in bytes[at..at + 16].chunks_exact_mut(2) {
+                pair.copy_from_slice(&[0xFF, 0x00]);
+            }
+            let msg = decode_texture(&bytes, Encoding::Srgb)
+                .err()
+                .unwrap_or_else(|| panic!("ones at byte {at} decoded"));
+            assert!(msg.starts_with("corrupt JPEG"), "{msg}");
+            assert!(!msg.contains('\n'), "{msg}");
+        }
+        let (mut refused, mut changed, mut same) = (0, 0, 0);
+        for _ in 0..40 {
+            let mut bytes = jpg.clone();
+            let at = data + 64 + (next() as usize) % 8192;
+            let r = next();
+            for (k, b) in bytes[at..at + 16].iter_mut().enumerate() {
+                *b = (r >> (k % 8 * 8)) as u8 & 0x7F;
+            }
+            match decode_texture(&bytes, Encoding::Srgb) {
+                Err(msg) => {
+                    assert!(msg.starts_with("corrupt JPEG"), "{msg}");
+                    refused += 1
+                }
+                Ok(t) if t.rgba8 != original.rgba8 => changed += 1,
+                Ok(_) => same += 1,
+            }
+        }
+        println!(
+            "random scan bytes: {refused} refused, {changed} decoded differently, {same} the same"
+        );
+        assert!(refused > 0);
+        // The scan's textures still load.
+        for name in [
+            "Map-COL.jpg",
+            "Map-SPEC.jpg",
+            "Infinite-Level_02_Tangent_SmoothUV.jpg",
+        ] {
+            load_texture(&assets().join(name), Encoding::Srgb).unwrap();
+        }
     }
 
     #[test]

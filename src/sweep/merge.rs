@@ -10,6 +10,7 @@
 
 use super::log::{self, Segment};
 use super::points::SWEEP_SCHEMA_VERSION;
+use super::shard::{self, Mode, Shard, Spec};
 use super::{ShardRun, Sweep};
 use crate::error::{Error, Result};
 use crate::profile::fingerprint::{run_id, timestamp};
@@ -195,8 +196,16 @@ pub fn merge_segments(mut segments: Vec<Segment>, opts: MergeOptions) -> Result<
         })
         .collect();
     if !missing.is_empty() {
+        let absent = absent_shards(&segments, &ids);
+        let absent = match absent.is_empty() {
+            true => String::new(),
+            false => format!(
+                "; no log of {} among the inputs (did that task fail, or write elsewhere?)",
+                absent.join(", ")
+            ),
+        };
         return Err(Error::Input(format!(
-            "sweep merge: {} of {} points missing: {}",
+            "sweep merge: {} of {} points missing: {}{absent}",
             missing.len(),
             ids.len(),
             missing.join("; ")
@@ -227,6 +236,36 @@ pub fn merge_segments(mut segments: Vec<Segment>, opts: MergeOptions) -> Result<
         .filter_map(|id| taken.remove(id).map(|(_, p)| p))
         .collect();
     Ok(Merged { sweep, warnings })
+}
+
+/// The shards of the partitions the logs come from (`hash:2/3`: every shard of
+/// 3 by hash) that no log is of, each with its file name: a whole shard lost.
+fn absent_shards(segments: &[Segment], ids: &[String]) -> Vec<String> {
+    let present: Vec<&str> = segments.iter().map(|s| s.header.shard.as_str()).collect();
+    let mut partitions: Vec<(Mode, u32)> = Vec::new();
+    for s in segments {
+        if let Ok(Spec::Explicit(shard)) = shard::parse(&s.header.shard) {
+            if !partitions.contains(&(shard.mode, shard.total)) {
+                partitions.push((shard.mode, shard.total));
+            }
+        }
+    }
+    let mut absent = Vec::new();
+    for (mode, total) in partitions {
+        for index in 1..=total {
+            let shard = Shard { mode, index, total };
+            let name = shard.to_string();
+            if !present.contains(&name.as_str()) {
+                let points = shard.select(ids).len();
+                absent.push(format!(
+                    "shard {name} ({}, {points} point{})",
+                    shard.file_name(),
+                    if points == 1 { "" } else { "s" }
+                ));
+            }
+        }
+    }
+    absent
 }
 
 /// The file a merged sweep's outputs go to when not given: the first input
@@ -353,6 +392,33 @@ mod tests {
             vec![point(256, 0.3), point(1024, 0.1)],
         )]);
         assert!(e.contains("r512-deon7-full") && e.contains("1 of 3"), "{e}");
+    }
+
+    #[test]
+    fn a_whole_missing_shard_is_named_with_its_file() {
+        // Shards 1 and 3 of 3 by position; shard 2's log is not given.
+        let ids: Vec<String> = [256, 512, 1024].map(|r| variant(r).id()).to_vec();
+        let of = |index: u32, points: Vec<Point>| {
+            let mut s = segment(&format!("points-shard-{index}-of-3.jsonl"), T0, points);
+            s.header.shard = format!("count:{index}/3");
+            s
+        };
+        let e = err(vec![
+            of(1, vec![point(256, 0.3)]),
+            of(3, vec![point(1024, 0.1)]),
+        ]);
+        assert!(
+            e.contains(&ids[1])
+                && e.contains("no log of shard count:2/3 (points-shard-2-of-3.jsonl, 1 point)"),
+            "{e}"
+        );
+        // A shard that ran but did not finish is not called absent.
+        let e = err(vec![
+            of(1, vec![point(256, 0.3)]),
+            of(2, vec![]),
+            of(3, vec![point(1024, 0.1)]),
+        ]);
+        assert!(!e.contains("no log of"), "{e}");
     }
 
     #[test]

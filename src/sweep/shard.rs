@@ -139,7 +139,9 @@ impl fmt::Display for Resolved {
 /// syntax). `auto` reads, first match wins: `DERMIS_SHARD` (unless itself
 /// `auto`); Slurm job arrays (`SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_MIN`,
 /// `SLURM_ARRAY_TASK_STEP`, `SLURM_ARRAY_TASK_COUNT`: index (ID − MIN) / STEP,
-/// 0-based); Kubernetes Indexed Jobs (`JOB_COMPLETION_INDEX`, 0-based, with the
+/// 0-based, of a regular array, checked against `SLURM_ARRAY_TASK_MAX`; with
+/// `DERMIS_SHARD_TOTAL` set, the task ID itself is the 1-based shard of that
+/// many, so a retried index keeps its shard); Kubernetes Indexed Jobs (`JOB_COMPLETION_INDEX`, 0-based, with the
 /// total in `DERMIS_SHARD_TOTAL`: the Job's `completions` is not in the pod's
 /// environment); GitLab `parallel:` (`CI_NODE_INDEX`, 1-based, `CI_NODE_TOTAL`);
 /// Bazel test sharding (`TEST_SHARD_INDEX`, 0-based, `TEST_TOTAL_SHARDS`).
@@ -214,24 +216,57 @@ fn from_env(mode: Mode, env: &dyn Fn(&str) -> Option<String>) -> Result<Resolved
         };
     }
     if let Some(id) = num("SLURM_ARRAY_TASK_ID")? {
+        let source = format!("SLURM_ARRAY_TASK_ID={id}");
+        // The shard count given: the task ID is the shard (1-based), whatever
+        // array it came from, so that a retry of one index (--array=2) runs
+        // that shard, not the whole sweep as "shard 1/1".
+        if let Some(total) = num("DERMIS_SHARD_TOTAL")? {
+            if let Some(count) = num("SLURM_ARRAY_TASK_COUNT")?.filter(|&c| c > total) {
+                return Err(Error::Input(format!(
+                    "--shard auto: the Slurm array has {count} tasks (SLURM_ARRAY_TASK_COUNT) but \
+                     DERMIS_SHARD_TOTAL={total}: submit --array=1-{total}, or set \
+                     DERMIS_SHARD_TOTAL={count}"
+                )));
+            }
+            if id == 0 || id > total {
+                return Err(Error::Input(format!(
+                    "--shard auto: with DERMIS_SHARD_TOTAL={total} the Slurm task ID is the \
+                     shard number, 1..={total}, but SLURM_ARRAY_TASK_ID={id} (submit \
+                     --array=1-{total}, or a retry's --array=I with I in 1..={total})"
+                )));
+            }
+            return done(id - 1, total, format!("{source}, DERMIS_SHARD_TOTAL"), None);
+        }
         let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
         let step = num("SLURM_ARRAY_TASK_STEP")?.unwrap_or(1).max(1);
         let count = need(
             "SLURM_ARRAY_TASK_COUNT",
             "SLURM_ARRAY_TASK_ID is set (a Slurm array task)",
         )?;
+        // A regular array MIN-MAX:STEP has (MAX − MIN) / STEP + 1 tasks; a
+        // list such as 1,4,9 (MIN 1, MAX 9, COUNT 3) does not, and its tasks
+        // cannot be told apart from shards of another array.
+        if let Some(max) = num("SLURM_ARRAY_TASK_MAX")? {
+            let regular = max >= min
+                && (max - min) % step == 0
+                && u64::from((max - min) / step) + 1 == u64::from(count);
+            if !regular {
+                return Err(Error::Input(format!(
+                    "--shard auto: the Slurm array is not a regular range: \
+                     SLURM_ARRAY_TASK_MIN={min}, MAX={max}, STEP={step} but COUNT={count} \
+                     (an index list such as --array=1,4,9, or a retry of some indices); \
+                     submit --array=1-{count}, or give each task its shard: DERMIS_SHARD=I/N, \
+                     or DERMIS_SHARD_TOTAL=N with the task ID as the shard number"
+                )));
+            }
+        }
         if id < min || (id - min) % step != 0 {
             return Err(Error::Input(format!(
                 "--shard auto: SLURM_ARRAY_TASK_ID={id} is not MIN {min} + a multiple of STEP {step} \
                  (use a regular array such as --array=1-{count})"
             )));
         }
-        return done(
-            (id - min) / step,
-            count,
-            format!("SLURM_ARRAY_TASK_ID={id}"),
-            None,
-        );
+        return done((id - min) / step, count, source, None);
     }
     if let Some(index0) = num("JOB_COMPLETION_INDEX")? {
         let total = need(
@@ -442,6 +477,123 @@ mod tests {
         assert_eq!(shard_of(Some("count:auto"), &both), (1, 2, Mode::Count));
         // No flag, no DERMIS_SHARD: the whole sweep, whatever the scheduler says.
         assert_eq!(resolved(None, &slurm).unwrap(), None);
+    }
+
+    /// Slurm 22.05 for `--array=1,4,9`: MIN 1, MAX 9, COUNT 3 (and STEP 1).
+    #[test]
+    fn an_irregular_slurm_list_is_refused_saying_why() {
+        for id in ["1", "4", "9"] {
+            let env = [
+                ("SLURM_ARRAY_TASK_ID", id),
+                ("SLURM_ARRAY_TASK_MIN", "1"),
+                ("SLURM_ARRAY_TASK_MAX", "9"),
+                ("SLURM_ARRAY_TASK_STEP", "1"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ];
+            let e = resolved(Some("auto"), &env).unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            let msg = e.to_string();
+            assert!(
+                msg.contains("not a regular range")
+                    && msg.contains("MAX=9")
+                    && msg.contains("COUNT=3")
+                    && msg.contains("--array=1-3"),
+                "{msg}"
+            );
+        }
+        // Regular arrays with MAX pass: 1-3, 0-10:5, and one index (MIN = MAX).
+        let regular: [&[(&str, &str)]; 3] = [
+            &[
+                ("SLURM_ARRAY_TASK_ID", "3"),
+                ("SLURM_ARRAY_TASK_MIN", "1"),
+                ("SLURM_ARRAY_TASK_MAX", "3"),
+                ("SLURM_ARRAY_TASK_STEP", "1"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "5"),
+                ("SLURM_ARRAY_TASK_MIN", "0"),
+                ("SLURM_ARRAY_TASK_MAX", "10"),
+                ("SLURM_ARRAY_TASK_STEP", "5"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "2"),
+                ("SLURM_ARRAY_TASK_MIN", "2"),
+                ("SLURM_ARRAY_TASK_MAX", "2"),
+                ("SLURM_ARRAY_TASK_COUNT", "1"),
+            ],
+        ];
+        let got: Vec<(u32, u32)> = regular
+            .iter()
+            .map(|env| {
+                let (i, n, _) = shard_of(Some("auto"), env);
+                (i, n)
+            })
+            .collect();
+        assert_eq!(got, [(3, 3), (2, 3), (1, 1)]);
+    }
+
+    /// A retry of one index (`sbatch --array=2`) with the recipe's
+    /// DERMIS_SHARD_TOTAL runs shard 2 of 3, not the whole sweep as 1/1.
+    #[test]
+    fn a_slurm_retry_with_the_shard_total_keeps_its_shard() {
+        let retry = [
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_MIN", "2"),
+            ("SLURM_ARRAY_TASK_MAX", "2"),
+            ("SLURM_ARRAY_TASK_STEP", "1"),
+            ("SLURM_ARRAY_TASK_COUNT", "1"),
+            ("DERMIS_SHARD_TOTAL", "3"),
+        ];
+        assert_eq!(shard_of(Some("auto"), &retry), (2, 3, Mode::Hash));
+        let r = resolved(Some("count:auto"), &retry).unwrap().unwrap();
+        assert_eq!(
+            r.to_string(),
+            "shard 2/3 by position (from SLURM_ARRAY_TASK_ID=2, DERMIS_SHARD_TOTAL)"
+        );
+        // Without the total the same task is the whole sweep: the recipe sets it.
+        let bare: Vec<(&str, &str)> = retry[..5].to_vec();
+        assert_eq!(shard_of(Some("auto"), &bare), (1, 1, Mode::Hash));
+        // Two of three retried as a list (--array=1,3) is fine with the total.
+        let list = [
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+            ("SLURM_ARRAY_TASK_MAX", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "2"),
+            ("DERMIS_SHARD_TOTAL", "3"),
+        ];
+        assert_eq!(shard_of(Some("auto"), &list), (3, 3, Mode::Hash));
+        // The total disagreeing with the array, or an ID outside it: refused.
+        for (env, needle) in [
+            (
+                vec![
+                    ("SLURM_ARRAY_TASK_ID", "1"),
+                    ("SLURM_ARRAY_TASK_COUNT", "5"),
+                    ("DERMIS_SHARD_TOTAL", "3"),
+                ],
+                "DERMIS_SHARD_TOTAL=3",
+            ),
+            (
+                vec![
+                    ("SLURM_ARRAY_TASK_ID", "0"),
+                    ("SLURM_ARRAY_TASK_COUNT", "3"),
+                    ("DERMIS_SHARD_TOTAL", "3"),
+                ],
+                "1..=3",
+            ),
+            (
+                vec![
+                    ("SLURM_ARRAY_TASK_ID", "4"),
+                    ("SLURM_ARRAY_TASK_COUNT", "1"),
+                    ("DERMIS_SHARD_TOTAL", "3"),
+                ],
+                "SLURM_ARRAY_TASK_ID=4",
+            ),
+        ] {
+            let e = resolved(Some("auto"), &env).unwrap_err().to_string();
+            assert!(e.contains(needle), "{env:?}: {e}");
+        }
     }
 
     #[test]

@@ -167,13 +167,27 @@ pub fn load_cached(dir: &Path, key: &str) -> Option<Transfer> {
 /// `"DRMSTRNS"`, u32 version (1), u32 key length, key bytes, u64 vertex count,
 /// `9 × count` f32 coefficients, then the u64 FNV-1a of all preceding bytes.
 pub fn store_cached(dir: &Path, key: &str, t: &Transfer) -> crate::Result<()> {
-    let path = cache_path(dir, key)
-        .ok_or_else(|| crate::Error::Input(format!("invalid cache key {key:?}")))?;
-    std::fs::create_dir_all(dir).map_err(|source| crate::Error::Io {
-        path: dir.display().to_string(),
-        source,
-    })?;
-    crate::atomic::write_atomic(&path, encode(key, t))
+    let stored = (|| {
+        let path = cache_path(dir, key)
+            .ok_or_else(|| crate::Error::Input(format!("invalid cache key {key:?}")))?;
+        std::fs::create_dir_all(dir).map_err(|source| crate::Error::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+        crate::atomic::write_atomic(&path, encode(key, t))
+    })();
+    if stored.is_err() {
+        STORE_FAILURES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+    stored
+}
+
+static STORE_FAILURES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many [`store_cached`] calls of this process failed (the transfers were
+/// computed, but not cached: `dermis precompute` fails then).
+pub fn store_failures() -> usize {
+    STORE_FAILURES.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// `compute()`'s RGB transfer of `vertices` vertices, or the copy cached under

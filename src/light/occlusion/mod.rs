@@ -30,7 +30,9 @@ pub(crate) mod testutil;
 mod transfer;
 
 pub use bvh::{Bvh, Hit};
-pub use cache::{cache_key, default_cache_dir, load_cached, rgb_cached, store_cached};
+pub use cache::{
+    cache_key, default_cache_dir, load_cached, rgb_cached, store_cached, store_failures,
+};
 pub use lobe::{
     above, kappa, lobe_raytrace, lobe_visibility, lobe_visibility_for, open as open_lobe, zonal,
 };
