@@ -36,57 +36,57 @@ pub fn medium(args: MediumArgs) -> dermis::Result<()> {
     let rgb = |v: [f32; 3]| format!("{:.4} {:.4} {:.4}", v[0], v[1], v[2]);
     let Some(m) = Medium::from_spec(&file.skin.medium) else {
         let p = dermis::skin::profile::Profile::skin();
-        println!("medium: deon2007 (d'Eon & Luebke's six Gaussians; no medium)");
+        outln!("medium: deon2007 (d'Eon & Luebke's six Gaussians; no medium)");
         for &d in &args.thickness {
-            println!(
+            outln!(
                 "T({d} mm) = Σ wᵢ exp(−d²/2vᵢ) = {}",
                 rgb(p.transmittance(d).to_array())
             );
         }
         return Ok(());
     };
-    println!("sigma_a       {} mm^-1", rgb(m.sigma_a.to_array()));
-    println!("sigma_s'      {} mm^-1", rgb(m.sigma_s_prime.to_array()));
-    println!("g {}, ior {}", m.g, m.ior);
-    println!(
+    outln!("sigma_a       {} mm^-1", rgb(m.sigma_a.to_array()));
+    outln!("sigma_s'      {} mm^-1", rgb(m.sigma_s_prime.to_array()));
+    outln!("g {}, ior {}", m.g, m.ior);
+    outln!(
         "1/sigma_tr    {} mm (diffuse mean free path)",
         rgb(m.dmfp().to_array())
     );
     let started = std::time::Instant::now();
     let t = MediumTables::load_or_compute(&m, &dermis::cache::default_cache_dir());
-    println!(
+    outln!(
         "tables        {:.2} s here (made in: walks {:.2} s, fits {:.2} s; cached in {})",
         started.elapsed().as_secs_f32(),
         t.walk_seconds,
         t.fit_seconds,
         dermis::cache::default_cache_dir().display()
     );
-    println!(
+    outln!(
         "albedo        {} (of the light entering, the share that leaves)",
         rgb(t.albedo)
     );
-    println!(
+    outln!(
         "fit error     {} (r-weighted L2 of R(r), relative)",
         rgb(t.fit_error)
     );
-    println!(
+    outln!(
         "reference fit {} ({} Gaussians, for reference --diffusion)",
         rgb(t.reference_error),
         t.reference_gaussians.len()
     );
-    println!("variance mm²  weights R G B");
+    outln!("variance mm²  weights R G B");
     for (v, w) in &t.gaussians {
-        println!("{v:>12.4}  {}", rgb(*w));
+        outln!("{v:>12.4}  {}", rgb(*w));
     }
     // Light arriving along the normal: the boundary's share enters, then the
     // walk's scattered and ballistic shares leave the far side.
     let enters = 1.0 - fresnel_dielectric(1.0, 1.0 / f64::from(m.ior));
-    println!("d mm   T(d) table (scattered)      walked: scattered             through (per unit irradiance)");
+    outln!("d mm   T(d) table (scattered)      walked: scattered             through (per unit irradiance)");
     for &d in &args.thickness {
         let walked = [0, 1, 2].map(|c| walk::slab_to_count(&m, c, f64::from(d), COUNT, 1 << 24));
         let scattered = walked.map(|s| s.scattered as f32);
         let through = walked.map(|s| (enters * (s.scattered + s.ballistic)) as f32);
-        println!(
+        outln!(
             "{d:<6} {}   {}   {}",
             rgb(t.transmittance_at(d).to_array()),
             rgb(scattered),
