@@ -245,7 +245,9 @@ mod tests {
             0.0,
             1.4,
         );
-        let t = MediumTables::compute(&m);
+        // Made once per machine (the GPU test in tests/transmission.rs reads
+        // the same cache); the checks below walk afresh.
+        let t = MediumTables::load_or_compute(&m, &crate::cache::default_cache_dir());
         println!(
             "skin1: albedo {:?}, fit error {:?}, reference fit error {:?}, walks {:.2} s, fits {:.2} s",
             t.albedo, t.fit_error, t.reference_error, t.walk_seconds, t.fit_seconds

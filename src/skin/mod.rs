@@ -94,11 +94,9 @@ pub struct MediumSkin {
 impl SkinSettings {
     pub fn resolve(skin: &Skin, render: &Render) -> Result<Self> {
         let medium = medium_skin(skin);
-        let profile = match &skin.profile {
-            _ if medium.is_some() => medium
-                .as_ref()
-                .map_or_else(Profile::skin, |m| m.tables.profile()),
-            Some(p) => Profile {
+        let profile = match (&medium, &skin.profile) {
+            (Some(m), _) => m.tables.profile(),
+            (None, Some(p)) => Profile {
                 gaussians: p
                     .iter()
                     .map(|g| Gaussian {
@@ -107,7 +105,7 @@ impl SkinSettings {
                     })
                     .collect(),
             },
-            None => Profile::skin(),
+            (None, None) => Profile::skin(),
         };
         if profile.gaussians.len() != 6 {
             return Err(Error::Input(format!(
