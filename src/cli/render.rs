@@ -74,6 +74,12 @@ pub struct RenderArgs {
     /// as a multiple of the copy's (docs/performance.md).
     #[arg(long)]
     ruler: bool,
+    /// Count every pass's work with pipeline statistics queries (vertices,
+    /// primitives, vertex, fragment and compute invocations) into the timing
+    /// table, report, CSV and trace; needs the device's
+    /// pipelineStatisticsQuery feature (docs/performance.md, "Work counters").
+    #[arg(long)]
+    counters: bool,
 }
 
 #[derive(Args)]
@@ -107,6 +113,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         scene_path: Some(args.scene.path()?),
         progress: std::io::stderr().is_terminal(),
         ruler: args.ruler,
+        counters: args.counters,
         runs: args.runs,
         warmup: args.warmup,
         warmup_ms: args.warmup_ms,

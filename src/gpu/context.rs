@@ -50,6 +50,9 @@ pub struct DeviceInfo {
     pub timestamps: bool,
     pub timestamp_period_ns: f32,
     pub timestamp_valid_bits: u32,
+    /// Pipeline statistics queries (the `pipelineStatisticsQuery` feature,
+    /// enabled on the device when offered): per-pass work counters.
+    pub pipeline_statistics: bool,
     pub max_image_dimension_2d: u32,
     pub memory_heaps: Vec<MemoryHeap>,
     pub validation: bool,
@@ -168,7 +171,13 @@ impl Context {
             validation.is_some(),
             swapchain,
         )?;
-        let device = create_device(&instance, physical, queue_family, swapchain)?;
+        let device = create_device(
+            &instance,
+            physical,
+            queue_family,
+            swapchain,
+            info.pipeline_statistics,
+        )?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -515,6 +524,7 @@ fn device_info(
         .get(family as usize)
         .map_or(0, |f| f.timestamp_valid_bits);
     let mem = unsafe { instance.get_physical_device_memory_properties(pd) };
+    let features = unsafe { instance.get_physical_device_features(pd) };
     let heaps = mem.memory_heaps[..mem.memory_heap_count as usize]
         .iter()
         .map(|h| MemoryHeap {
@@ -533,6 +543,7 @@ fn device_info(
         timestamps: valid_bits > 0 && props.limits.timestamp_compute_and_graphics != 0,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamp_valid_bits: valid_bits,
+        pipeline_statistics: features.pipeline_statistics_query != 0,
         max_image_dimension_2d: props.limits.max_image_dimension2_d,
         memory_heaps: heaps,
         validation,
@@ -544,6 +555,7 @@ fn create_device(
     pd: vk::PhysicalDevice,
     family: u32,
     swapchain: bool,
+    pipeline_statistics: bool,
 ) -> Result<ash::Device> {
     let priorities = [1.0];
     let queues = [vk::DeviceQueueCreateInfo::default()
@@ -557,8 +569,12 @@ fn create_device(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .dynamic_rendering(true);
+    // Enabling the feature costs nothing until a query is begun.
+    let features =
+        vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
+        .enabled_features(&features)
         .enabled_extension_names(&extensions)
         .push_next(&mut f12)
         .push_next(&mut f13);

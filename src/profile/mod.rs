@@ -1,20 +1,29 @@
 //! Frame reports: per-pass GPU time and start within the frame, CPU record/submit
 //! time; run reports with statistics over warmed-up frames; trace and CSV output.
 
+#[cfg(test)]
+mod aa_study;
 mod bootstrap;
+mod bound;
 pub mod compare;
+mod counters;
 pub mod csv;
 pub mod export;
 pub mod fingerprint;
+mod measurement;
 mod run;
 mod significance;
 mod stats;
 pub mod trace;
+mod ttest;
+mod verdict;
 
+pub use bound::{Bound, BoundBy};
+pub use counters::PassCounters;
 pub use fingerprint::Fingerprint;
 pub use run::{
     is_ruler, CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY,
-    RULER_COPY, RULER_READ, SCHEMA_VERSION, VERSION,
+    RULER_COPY, RULER_EMPTY, RULER_READ, SCHEMA_VERSION, VERSION,
 };
 pub use stats::Stats;
 
@@ -48,6 +57,9 @@ pub struct PassTime {
     /// From the frame's start (first timestamp, or host start with host fences)
     /// to the pass's start.
     pub start_ns: Option<f64>,
+    /// Pipeline statistics (`render --counters`); absent when not counted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub counters: Option<PassCounters>,
 }
 
 /// What one frame cost.
@@ -147,6 +159,13 @@ impl FrameReport {
         }
     }
 
+    /// Attaches each pass's counters, in pass order.
+    pub fn set_counters(&mut self, counters: &[PassCounters]) {
+        for (p, c) in self.passes.iter_mut().zip(counters) {
+            p.counters = Some(*c);
+        }
+    }
+
     pub fn pass_start_ns(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|p| p.name == name)?.start_ns
     }
@@ -169,6 +188,12 @@ impl FrameReport {
                     .iter()
                     .filter_map(|f| f.pass_start_ns(&p.name))
                     .collect()),
+                counters: PassCounters::median(
+                    &frames
+                        .iter()
+                        .filter_map(|f| f.pass(&p.name)?.counters)
+                        .collect::<Vec<_>>(),
+                ),
             })
             .collect();
         Some(FrameReport {

@@ -1,12 +1,17 @@
 //! `--trace FILE.json`: the run as Chrome trace events (Perfetto, chrome://tracing).
 //! One track per clock; on it a slice for the run, one per frame at the frame's
 //! start, and one per pass at frame start + the pass's start offset, so passes
-//! nest in their frame and frames in the run.
+//! nest in their frame and frames in the run. Work counters (`--counters`) are
+//! in each pass's arguments and on counter tracks (fragment and compute
+//! invocations: the pass's count from its start, 0 from its end).
 
 use super::run::RunReport;
 use serde_json::{json, Value};
 
 const PID: u32 = 1;
+/// The counter tracks' names.
+const FRAGMENTS: &str = "fragment invocations";
+const INVOCATIONS: &str = "compute invocations";
 
 /// `ts` and `dur` in µs of a slice from `begin` to `end` ns, both rounded to whole
 /// ns first: a pass that ends with its frame keeps ending with it (no nesting
@@ -42,6 +47,7 @@ pub fn trace(report: &RunReport) -> Value {
     }
     // Frames without a start (no timestamps) follow the previous one.
     let mut slices = Vec::new();
+    let mut counters = Vec::new();
     let mut cursor = 0.0f64;
     let mut run_end = 0.0f64;
     // Each run's clock starts again at 0: runs follow one another.
@@ -73,10 +79,25 @@ pub fn trace(report: &RunReport) -> Value {
                 continue;
             };
             let (ts, dur_us) = ts_dur(start + offset, start + offset + dur);
+            let mut args = json!({ "run": f.run, "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur });
+            if let Some(c) = &p.counters {
+                args["counters"] = json!(c);
+                for (name, value) in [
+                    (FRAGMENTS, c.fragment_invocations),
+                    (INVOCATIONS, c.compute_invocations),
+                ] {
+                    for (t, v) in [(ts, value), (ts + dur_us, 0)] {
+                        counters.push(json!({
+                            "name": name, "cat": "counter", "ph": "C", "pid": PID, "ts": t,
+                            "args": { name: v },
+                        }));
+                    }
+                }
+            }
             slices.push(json!({
                 "name": p.name, "cat": "pass", "ph": "X",
                 "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur_us,
-                "args": { "run": f.run, "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur },
+                "args": args,
             }));
         }
     }
@@ -97,6 +118,7 @@ pub fn trace(report: &RunReport) -> Value {
         }));
     }
     events.extend(slices);
+    events.extend(counters);
     json!({ "traceEvents": events, "displayTimeUnit": "ns" })
 }
 
@@ -191,6 +213,35 @@ mod tests {
             (pass["ts"].as_f64(), pass["dur"].as_f64()),
             (Some(1.006), Some(0.005))
         );
+    }
+
+    #[test]
+    fn counters_are_pass_arguments_and_counter_tracks() {
+        let mut r = report(&[30.0]);
+        r.per_frame[0].passes[0].counters = Some(crate::profile::PassCounters {
+            fragment_invocations: 96,
+            compute_invocations: 7,
+            ..Default::default()
+        });
+        let t = trace(&r);
+        let pass = slices(&t, "pass")[0];
+        assert_eq!(pass["args"]["counters"]["fragment_invocations"], 96);
+        assert!(slices(&t, "pass")[1]["args"].get("counters").is_none());
+        let c = slices(&t, "counter");
+        assert_eq!(c.len(), 4);
+        // The fragments' track: 96 from the pass's start, 0 from its end.
+        let (p0, p1) = span(pass);
+        assert_eq!(c[0]["ph"], "C");
+        assert_eq!(c[0]["name"], FRAGMENTS);
+        assert_eq!(
+            (c[0]["ts"].as_f64().unwrap(), &c[0]["args"][FRAGMENTS]),
+            (p0, &json!(96))
+        );
+        assert_eq!(
+            (c[1]["ts"].as_f64().unwrap(), &c[1]["args"][FRAGMENTS]),
+            (p1, &json!(0))
+        );
+        assert_eq!(c[2]["args"][INVOCATIONS], 7);
     }
 
     #[test]

@@ -47,6 +47,9 @@ pub struct RenderOptions {
     pub progress: bool,
     /// Time the rulers (render::ruler) in every frame.
     pub ruler: bool,
+    /// Count every pass's work (pipeline statistics) in every frame
+    /// (graph::Executor::set_counters).
+    pub counters: bool,
     /// Independent repetitions, each with a fresh upload, pipelines and warm-up;
     /// the image is the last run's.
     pub runs: u32,
@@ -99,6 +102,7 @@ impl Default for RenderOptions {
             scene_path: None,
             progress: false,
             ruler: false,
+            counters: false,
             runs: 1,
             warmup: None,
             warmup_ms: None,
@@ -238,6 +242,13 @@ pub fn render_scene(
         }
     }
     let warmup = opts.warmup_frames()?;
+    if opts.counters && !ctx.info.pipeline_statistics {
+        return Err(Error::Input(format!(
+            "--counters: {} offers no pipeline statistics queries (the \
+             pipelineStatisticsQuery feature); render without --counters",
+            ctx.info.name
+        )));
+    }
     let skin = settings(ctx, scene)?;
     if opts.view == View::Screen(Screen::Reference) {
         return reference(ctx, scene, opts);
@@ -424,6 +435,7 @@ fn run(
     let exposure_readback = Readback::new(ctx, "readback exposure", meter::RESULT_BYTES)?;
 
     let mut executor = Executor::new(ctx, 2)?;
+    executor.set_counters(opts.counters)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
     let mut gpu_metered = false;
@@ -587,6 +599,7 @@ mod tests {
             timestamps: true,
             timestamp_period_ns: 1.0,
             timestamp_valid_bits: 64,
+            pipeline_statistics: true,
             max_image_dimension_2d: 8192,
             memory_heaps: Vec::new(),
             validation: false,
