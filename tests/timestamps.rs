@@ -132,6 +132,14 @@ fn rulers_and_per_texel_figures() {
     let copy_gb = (2 * res * res * 8) as f64 / pass("ruler_copy").time.unwrap().median_ns;
     let bw = (3 * res * res * 8) as f64 / blur.time.unwrap().median_ns / copy_gb;
     assert!((blur.of_ruler_bandwidth.unwrap() - bw).abs() < 1e-9 * bw);
+    // The final pass samples the 256² levels at 64 × 48 pixels: it can touch
+    // one texel of each per pixel, not the whole level.
+    let skin = pass("skin");
+    assert!(
+        skin.touched_bytes.unwrap() < skin.bytes.unwrap(),
+        "{skin:?}"
+    );
+    assert_eq!(blur.touched_bytes, blur.bytes);
     // Screen passes count output pixels.
     assert_eq!(pass("skin").texels, Some(w as u64 * h as u64));
     assert!(r.table().contains("ns/texel") && r.table().contains("×ruler"));

@@ -38,6 +38,9 @@ use serde::{Deserialize, Serialize};
 pub struct PassWork {
     pub texels: Option<u64>,
     pub bytes: u64,
+    /// `bytes` with each image capped at one texel per invocation: what a pass
+    /// that samples a large image at few points can touch of it.
+    pub touched_bytes: u64,
     pub tags: Vec<&'static str>,
 }
 
@@ -49,6 +52,9 @@ pub struct PassTime {
     pub texels: Option<u64>,
     /// Nominal traffic (see [`PassWork`]).
     pub bytes: Option<u64>,
+    /// Traffic it can touch (see [`PassWork`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touched_bytes: Option<u64>,
     /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tags: Vec<String>,
@@ -97,6 +103,7 @@ impl FrameReport {
         for (p, w) in self.passes.iter_mut().zip(work) {
             p.texels = w.texels;
             p.bytes = Some(w.bytes);
+            p.touched_bytes = Some(w.touched_bytes);
             p.tags = w.tags.iter().map(|t| t.to_string()).collect();
         }
     }
@@ -182,6 +189,7 @@ impl FrameReport {
                 name: p.name.clone(),
                 texels: p.texels,
                 bytes: p.bytes,
+                touched_bytes: p.touched_bytes,
                 tags: p.tags.clone(),
                 gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
                 start_ns: med(frames

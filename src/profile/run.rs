@@ -144,9 +144,14 @@ pub struct PassStats {
     pub gb_per_s: Option<f64>,
     /// ns/texel as a multiple of the copy ruler's in the same run.
     pub x_ruler: Option<f64>,
-    /// `gb_per_s` as a fraction of the copy ruler's in the same run: how close
-    /// the pass's nominal traffic comes to what a plain copy achieves (> 1:
-    /// caches serve some of it, or it reads less than it declares).
+    /// Traffic it can touch: each image it uses capped at one texel per
+    /// invocation (a screen pass sampling a 4096² level at its pixels touches
+    /// those, not the level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touched_bytes: Option<u64>,
+    /// Touched bytes per ns as a fraction of the copy ruler's in the same run:
+    /// how close the pass comes to what a plain copy achieves (> 1: caches
+    /// serve some of it, or it touches less than it declares).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub of_ruler_bandwidth: Option<f64>,
     /// What bounds the pass (profile::bound), where the rulers ran.
@@ -192,6 +197,7 @@ impl PassStats {
         self.tags = work.map(|p| p.tags.clone()).unwrap_or_default();
         self.texels = texels;
         self.bytes = bytes;
+        self.touched_bytes = work.and_then(|p| p.touched_bytes);
         self.ns_per_texel = median
             .zip(texels.filter(|&t| t > 0))
             .map(|(t, n)| t / n as f64);
@@ -305,13 +311,15 @@ impl RunReport {
             })
             .collect();
         let ruler = passes.iter().find(|p| p.name == RULER_COPY);
-        let (ruler_ns, ruler_gb) = (
-            ruler.and_then(|p| p.ns_per_texel),
-            ruler.and_then(|p| p.gb_per_s),
-        );
+        // Touched bytes per ns.
+        let touched = |p: &PassStats| {
+            let (t, b) = (p.time?.median_ns, p.touched_bytes?);
+            (t > 0.0).then(|| b as f64 / t)
+        };
+        let (ruler_ns, ruler_gb) = (ruler.and_then(|p| p.ns_per_texel), ruler.and_then(touched));
         for p in &mut passes {
             p.x_ruler = p.ns_per_texel.zip(ruler_ns).map(|(a, r)| a / r);
-            p.of_ruler_bandwidth = p.gb_per_s.zip(ruler_gb).map(|(a, r)| a / r);
+            p.of_ruler_bandwidth = touched(p).zip(ruler_gb).map(|(a, r)| a / r);
         }
         let empty_ns = passes
             .iter()
