@@ -7,7 +7,7 @@ use super::plan::{Barrier, Plan, PoolState};
 use super::{Graph, Imported, LoadOp, ResourceKind};
 use crate::error::{Error, Result, VkResultExt};
 use crate::gpu::{full_range, Context, Image};
-use crate::profile::{FrameReport, PassCounters, PassTime, PassWork};
+use crate::profile::{CpuSpan, FrameReport, PassCounters, PassTime, PassWork};
 use ash::vk;
 use std::ffi::CString;
 use std::sync::Arc;
@@ -39,6 +39,8 @@ struct InFlight {
     pass_names: Vec<String>,
     work: Vec<PassWork>,
     counted: bool,
+    /// Record and submit, on the host clock from `host_epoch`.
+    spans: Vec<CpuSpan>,
     cpu_record_ns: f64,
     cpu_submit_ns: f64,
     _graph: Graph,
@@ -103,6 +105,9 @@ pub struct Executor {
     /// timestamp (GPU clock) and an instant (host clock).
     gpu_epoch: Option<u64>,
     host_epoch: Option<Instant>,
+    /// A GPU timestamp and the host instant of the same moment
+    /// (Context::calibrate), taken with the first frame on GPU timestamps.
+    calibration: Option<(u64, Instant)>,
     /// Submissions wait while another thread holds `Context::foreground`.
     background: bool,
 }
@@ -121,6 +126,7 @@ impl Executor {
             pool_images: Vec::new(),
             gpu_epoch: None,
             host_epoch: None,
+            calibration: None,
             background: false,
         };
         for _ in 0..frames_in_flight.max(1) {
@@ -276,15 +282,24 @@ impl Executor {
             return Ok(previous.or(Some(report)));
         }
         self.ensure_queries(index, 2 + 2 * n as u32)?;
+        if self.host_epoch.is_none() {
+            self.host_epoch = Some(started);
+            self.calibration = self.ctx.calibrate().map(|(ticks, at, _)| (ticks, at));
+        }
         self.record(index, &compiled, &images, &buffers, 0..n)?;
         let recorded = Instant::now();
         self.submit_slot(index, sync)?;
         let submitted = Instant::now();
+        let spans = vec![
+            self.span("record", None, started, recorded),
+            self.span("submit", None, recorded, submitted),
+        ];
         self.slots[index].in_flight = Some(InFlight {
             frame: self.frame,
             pass_names: names,
             work,
             counted: self.counters,
+            spans,
             cpu_record_ns: (recorded - started).as_nanos() as f64,
             cpu_submit_ns: (submitted - recorded).as_nanos() as f64,
             _graph: compiled.graph,
@@ -292,6 +307,17 @@ impl Executor {
         self.frame += 1;
         self.next = (index + 1) % self.slots.len();
         Ok(previous)
+    }
+
+    /// A CPU span from `a` to `b` on the host clock from the epoch.
+    fn span(&self, what: &str, pass: Option<&str>, a: Instant, b: Instant) -> CpuSpan {
+        let epoch = self.host_epoch.unwrap_or(a);
+        CpuSpan {
+            what: what.into(),
+            pass: pass.map(str::to_string),
+            start_ns: a.saturating_duration_since(epoch).as_nanos() as f64,
+            dur_ns: b.saturating_duration_since(a).as_nanos() as f64,
+        }
     }
 
     fn submit_slot(&self, index: usize, sync: FrameSync) -> Result<()> {
@@ -343,6 +369,7 @@ impl Executor {
         let epoch = *self.host_epoch.get_or_insert(frame_start);
         let (mut record_ns, mut submit_ns) = (0.0, 0.0);
         let mut passes = Vec::with_capacity(names.len());
+        let mut spans = Vec::with_capacity(3 * names.len());
         let count = names.len().max(1);
         for i in 0..count {
             let t0 = Instant::now();
@@ -359,6 +386,10 @@ impl Executor {
             let t3 = Instant::now();
             record_ns += (t1 - t0).as_nanos() as f64;
             submit_ns += (t2 - t1).as_nanos() as f64;
+            let pass = names.get(i).map(String::as_str);
+            spans.push(self.span("record", pass, t0, t1));
+            spans.push(self.span("submit", pass, t1, t2));
+            spans.push(self.span("wait", pass, t2, t3));
             if let Some(name) = names.get(i) {
                 passes.push(PassTime {
                     name: name.clone(),
@@ -377,6 +408,8 @@ impl Executor {
             cpu_submit_ns: submit_ns,
             dropped_deltas: 0,
             clock: "host-fence".into(),
+            host_start_ns: Some((frame_start - epoch).as_nanos() as f64),
+            cpu_spans: spans,
             ..Default::default()
         })
     }
@@ -415,7 +448,9 @@ impl Executor {
         };
         let slot = &self.slots[index];
         let d = &self.ctx.device;
+        let wait_start = Instant::now();
         unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let wait = self.span("wait", None, wait_start, Instant::now());
         unsafe { d.reset_fences(&[slot.fence]) }.vk("vkResetFences")?;
         let mut report = if slot.queries != vk::QueryPool::null() {
             let mut raw = vec![0u64; 2 + 2 * done.pass_names.len()];
@@ -443,13 +478,22 @@ impl Executor {
                 bits => (1u64 << bits) - 1,
             };
             let ticks = raw[0].wrapping_sub(epoch) & mask;
-            report.start_ns = Some(ticks as f64 * info.timestamp_period_ns as f64);
+            let period = info.timestamp_period_ns as f64;
+            report.start_ns = Some(ticks as f64 * period);
+            // On the host clock: the calibration's instant, plus the ticks since.
+            if let (Some((at_ticks, at)), Some(host)) = (self.calibration, self.host_epoch) {
+                let since = (raw[0].wrapping_sub(at_ticks) & mask) as f64 * period;
+                report.host_start_ns =
+                    Some(at.saturating_duration_since(host).as_nanos() as f64 + since);
+            }
             report
         } else {
             // No timestamps on this device: passes are listed without GPU times.
             FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
         };
         report.set_work(&done.work);
+        report.cpu_spans = done.spans;
+        report.cpu_spans.push(wait);
         if done.counted {
             report.set_counters(&self.read_counters(index, done.pass_names.len())?);
         }

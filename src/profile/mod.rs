@@ -68,6 +68,19 @@ pub struct PassTime {
     pub counters: Option<PassCounters>,
 }
 
+/// A span of the CPU's work for a frame, on the host's clock.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CpuSpan {
+    /// `record`, `submit` or `wait` (for the frame's fence).
+    pub what: String,
+    /// The pass it was for, where one submission per pass (host fences).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pass: Option<String>,
+    /// From the executor's first frame's host start.
+    pub start_ns: f64,
+    pub dur_ns: f64,
+}
+
 /// What one frame cost.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 pub struct FrameReport {
@@ -90,6 +103,15 @@ pub struct FrameReport {
     pub dropped_deltas: u32,
     /// What measured the passes: "gpu-timestamp" or "host-fence".
     pub clock: String,
+    /// The frame's start on the host's clock, from the executor's first
+    /// frame's host start — the clock of `cpu_spans`: GPU timestamps put on
+    /// it by calibrated timestamps, or the host clock itself with host fences.
+    /// `None` where the clocks are not aligned.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host_start_ns: Option<f64>,
+    /// The CPU's record, submit and wait spans for this frame.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cpu_spans: Vec<CpuSpan>,
 }
 
 impl FrameReport {

@@ -642,6 +642,7 @@ pub(super) mod tests {
             timestamp_period_ns: 1.0,
             timestamp_valid_bits: 64,
             pipeline_statistics: true,
+            calibrated_timestamps: false,
             max_image_dimension_2d: 8192,
             memory_heaps: Vec::new(),
             validation: false,

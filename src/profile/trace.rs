@@ -1,7 +1,10 @@
 //! `--trace FILE.json`: the run as Chrome trace events (Perfetto, chrome://tracing).
 //! One track per clock; on it a slice for the run, one per frame at the frame's
 //! start, and one per pass at frame start + the pass's start offset, so passes
-//! nest in their frame and frames in the run. Work counters (`--counters`) are
+//! nest in their frame and frames in the run. Where the frames carry their
+//! start on the host's clock (calibrated GPU timestamps, or host fences), the
+//! frames go there and a second track holds the CPU's record, submit and wait
+//! spans: one timeline. Work counters (`--counters`) are
 //! in each pass's arguments and on counter tracks (fragment and compute
 //! invocations: the pass's count from its start, 0 from its end).
 
@@ -9,6 +12,8 @@ use super::run::RunReport;
 use serde_json::{json, Value};
 
 const PID: u32 = 1;
+/// The CPU track's thread id (the queue's tracks count from 1).
+const CPU_TID: u32 = 100;
 /// The counter tracks' names.
 const FRAGMENTS: &str = "fragment invocations";
 const INVOCATIONS: &str = "compute invocations";
@@ -34,8 +39,18 @@ pub fn trace(report: &RunReport) -> Value {
         "name": "process_name", "ph": "M", "pid": PID, "tid": 0,
         "args": { "name": format!("dermis {} ({}) on {}", report.dermis_version, report.git_commit, report.fingerprint.device) },
     })];
+    let aligned = report.per_frame.iter().any(|f| f.host_start_ns.is_some());
+    if aligned {
+        events.push(json!({
+            "name": "thread_name", "ph": "M", "pid": PID, "tid": CPU_TID,
+            "args": { "name": "CPU: record, submit, wait (host clock)" },
+        }));
+    }
     for c in &clocks {
         let name = match *c {
+            "gpu-timestamp" if aligned => {
+                "queue 0: GPU timestamps on the host clock (calibrated)".to_string()
+            }
             "gpu-timestamp" => "queue 0: GPU timestamps".to_string(),
             "host-fence" => "queue 0: host clock, submit to fence per pass".to_string(),
             other => format!("queue 0: {other}"),
@@ -56,7 +71,22 @@ pub fn trace(report: &RunReport) -> Value {
         if i > 0 && f.run != report.per_frame[i - 1].run {
             run_base = run_end;
         }
-        let start = f.start_ns.map_or(cursor, |s| run_base + s);
+        let start = match f.host_start_ns.filter(|_| aligned) {
+            Some(h) => run_base + h,
+            None => f.start_ns.map_or(cursor, |s| run_base + s),
+        };
+        for c in f.cpu_spans.iter().filter(|_| aligned) {
+            let (ts, dur) = ts_dur(run_base + c.start_ns, run_base + c.start_ns + c.dur_ns);
+            run_end = run_end.max(run_base + c.start_ns + c.dur_ns);
+            let name = match &c.pass {
+                Some(p) => format!("{} {p}", c.what),
+                None => c.what.clone(),
+            };
+            slices.push(json!({
+                "name": name, "cat": "cpu", "ph": "X", "pid": PID, "tid": CPU_TID,
+                "ts": ts, "dur": dur, "args": { "run": f.run, "frame": f.frame },
+            }));
+        }
         let pass_end = f
             .passes
             .iter()
@@ -242,6 +272,46 @@ mod tests {
             (p1, &json!(0))
         );
         assert_eq!(c[2]["args"][INVOCATIONS], 7);
+    }
+
+    #[test]
+    fn host_clock_frames_and_cpu_spans_share_the_timeline() {
+        let mut r = report(&[30.0]);
+        let f = &mut r.per_frame[0];
+        // GPU timestamps say 1000; calibrated, the frame began at 5000 on the host.
+        f.start_ns = Some(1000.0);
+        f.host_start_ns = Some(5000.0);
+        f.cpu_spans = vec![
+            crate::profile::CpuSpan {
+                what: "record".into(),
+                start_ns: 4000.0,
+                dur_ns: 500.0,
+                ..Default::default()
+            },
+            crate::profile::CpuSpan {
+                what: "wait".into(),
+                start_ns: 4600.0,
+                dur_ns: 500.0,
+                ..Default::default()
+            },
+        ];
+        let t = trace(&r);
+        assert_eq!(span(slices(&t, "frame")[0]).0, 5.0);
+        let cpu = slices(&t, "cpu");
+        assert_eq!(cpu.len(), 2);
+        assert!(cpu.iter().all(|e| e["tid"] == CPU_TID));
+        assert_eq!(
+            (cpu[1]["name"].as_str(), span(cpu[1])),
+            (Some("wait"), (4.6, 5.1))
+        );
+        let names: Vec<_> = t["traceEvents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e["ph"] == "M")
+            .map(|e| e["args"]["name"].as_str().unwrap().to_string())
+            .collect();
+        assert!(names.iter().any(|n| n.starts_with("CPU")), "{names:?}");
     }
 
     #[test]
