@@ -133,9 +133,17 @@ fn every_pass_of_a_render_is_counted() {
     // its depth test): only that the pass shaded something.
     let f = skin.fragments_per_pixel.expect("the skin pass shades");
     assert!(f > 0.0, "skin: {f} fragments per pixel");
+    // Creation feedback: the render's pipelines, each with a time, slowest first.
+    assert!(!report.pipelines.is_empty());
+    assert!(report.pipelines.iter().all(|p| p.creation_ns > 0.0));
+    assert!(report
+        .pipelines
+        .windows(2)
+        .all(|w| w[0].creation_ns >= w[1].creation_ns));
     let table = report.table();
     assert!(
         table.contains("frag/px") && table.contains("inv/texel"),
         "{table}"
     );
+    assert!(table.contains("pipelines (once per render)"), "{table}");
 }

@@ -22,8 +22,8 @@ pub use bound::{Bound, BoundBy};
 pub use counters::PassCounters;
 pub use fingerprint::Fingerprint;
 pub use run::{
-    is_ruler, CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY,
-    RULER_COPY, RULER_EMPTY, RULER_READ, SCHEMA_VERSION, VERSION,
+    is_ruler, CameraSetup, MemoryUse, PassStats, PipelineTime, RunReport, RunSetup, GIT_COMMIT,
+    GIT_DIRTY, RULER_COPY, RULER_EMPTY, RULER_READ, SCHEMA_VERSION, VERSION,
 };
 pub use stats::Stats;
 

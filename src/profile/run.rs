@@ -111,6 +111,15 @@ pub struct MemoryUse {
     pub reserved_bytes: u64,
 }
 
+/// How long the driver took to create one of the render's pipelines
+/// (pipeline creation feedback).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct PipelineTime {
+    /// Its shaders (`vertex+fragment` for graphics pipelines).
+    pub name: String,
+    pub creation_ns: f64,
+}
+
 /// The pass whose cost per texel every other pass is compared with (render's
 /// `--ruler`: a plain RGBA16F copy at the irradiance resolution).
 pub const RULER_COPY: &str = "ruler_copy";
@@ -267,6 +276,10 @@ pub struct RunReport {
     /// validation off.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation_messages: Option<u32>,
+    /// The last run's cached pipelines, once per render: how long the driver
+    /// took to create each (creation feedback), slowest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pipelines: Vec<PipelineTime>,
 }
 
 impl RunReport {
@@ -379,6 +392,7 @@ impl RunReport {
             warmup_only,
             per_frame,
             validation_messages: device.validation.then(crate::gpu::validation_messages),
+            pipelines: Vec::new(),
         }
     }
 
@@ -527,6 +541,21 @@ impl RunReport {
             s += &format!(
                 "once per render (warm-up frame only, ms): {}\n",
                 once.join(", ")
+            );
+        }
+        if !self.pipelines.is_empty() {
+            let total: f64 = self.pipelines.iter().map(|p| p.creation_ns).sum();
+            let slowest: Vec<String> = self
+                .pipelines
+                .iter()
+                .take(3)
+                .map(|p| format!("{} {:.1}", p.name, p.creation_ns / 1e6))
+                .collect();
+            s += &format!(
+                "pipelines (once per render): {} created in {:.1} ms; slowest (ms): {}\n",
+                self.pipelines.len(),
+                total / 1e6,
+                slowest.join(", ")
             );
         }
         let dropped: u32 = measured.iter().map(|f| f.dropped_deltas).sum();

@@ -20,7 +20,7 @@ use crate::light::reference::{render_view_with, ReferenceImage, Settings as Refe
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::profile::{CameraSetup, MemoryUse, RunReport, RunSetup};
+use crate::profile::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
 use crate::scene::checker;
 use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
@@ -274,7 +274,7 @@ pub fn render_scene(
     }
     let mut out = last.expect("at least one run");
     let r = &out.report;
-    let preroll_ms = r.preroll_ms;
+    let (preroll_ms, pipelines) = (r.preroll_ms, r.pipelines.clone());
     out.report = RunReport::new(
         &ctx.info,
         r.setup.clone(),
@@ -284,6 +284,7 @@ pub fn render_scene(
         r.memory,
     );
     out.report.preroll_ms = preroll_ms;
+    out.report.pipelines = pipelines;
     Ok(out)
 }
 
@@ -528,6 +529,11 @@ fn run(
     let warmup = opts.warmup_frames()? as usize;
     let mut report = RunReport::new(&ctx.info, run_setup, (w, h), reports, warmup, memory);
     report.preroll_ms = preroll.as_millis() as u64;
+    report.pipelines = frame
+        .pipeline_times()
+        .into_iter()
+        .map(|(name, creation_ns)| PipelineTime { name, creation_ns })
+        .collect();
     Ok(RenderOutput {
         width: w,
         height: h,
