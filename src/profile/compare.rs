@@ -10,7 +10,7 @@
 pub use super::measurement::{MeasuredFrame, Measurement, FRAME_ROW};
 pub use super::verdict::{Test, Verdict};
 
-use super::measurement::{samples, setup_differences};
+use super::measurement::{join_split_passes, samples, setup_differences};
 use super::run::{is_ruler, RULER_COPY};
 use super::significance::holm;
 use super::stats::{median, Stats};
@@ -222,36 +222,6 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
         only_in_new,
         joined,
     })
-}
-
-/// A pass `X` one side runs whole and the other as `X_u` then `X_v` (a blur
-/// level in one pass since issue 24, in two before): `side`'s two are joined,
-/// frame by frame, into one pass `X` in `X_u`'s place, counted at `X_v`'s
-/// texels (the level's), so the rows compare like with like. Returns what was
-/// joined.
-fn join_split_passes(side: &mut Measurement, other: &Measurement) -> Vec<String> {
-    let mut joined = Vec::new();
-    for name in &other.pass_order {
-        let (u, v) = (format!("{name}_u"), format!("{name}_v"));
-        let split = |m: &Measurement| m.pass_order.contains(&u) && m.pass_order.contains(&v);
-        if side.pass_order.contains(name) || !split(side) || split(other) {
-            continue;
-        }
-        for f in &mut side.frames {
-            if let (Some(a), Some(b)) = (f.passes.remove(&u), f.passes.remove(&v)) {
-                f.passes.insert(name.clone(), a + b);
-            }
-        }
-        side.pass_order.retain(|p| *p != v);
-        if let Some(p) = side.pass_order.iter_mut().find(|p| **p == u) {
-            *p = name.clone();
-        }
-        if let Some(t) = side.texels.get(&v).copied() {
-            side.texels.insert(name.clone(), t);
-        }
-        joined.push(format!("{name} = {u} + {v} in {}", side.source));
-    }
-    joined
 }
 
 /// The threshold and the level must be fractions.
