@@ -69,8 +69,9 @@ pub struct RenderArgs {
     /// Print the compiled render graph (passes, barriers, lifetimes).
     #[arg(long)]
     dump_graph: bool,
-    /// Also time two ruler passes at the irradiance resolution (an RGBA16F copy,
-    /// `ruler_copy`, and a read, `ruler_read`) and report every pass's ns/texel
+    /// Also time three ruler passes at the irradiance resolution (an RGBA16F
+    /// copy, `ruler_copy`, a read, `ruler_read`, and one workgroup of the read,
+    /// `ruler_empty`) and report every pass's ns/texel
     /// as a multiple of the copy's (docs/performance.md).
     #[arg(long)]
     ruler: bool,
