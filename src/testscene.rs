@@ -30,6 +30,8 @@ pub struct CompositePush {
 pub struct TestScene {
     pub pattern: Arc<Pipeline>,
     pub blur: Arc<Pipeline>,
+    /// All arithmetic: `alu_heavy.comp` (push: size, iterations).
+    pub alu: Arc<Pipeline>,
     /// Composite into RGBA8 (sRGB-encoded by the shader) for PNG output.
     pub composite_rgba8: Arc<Pipeline>,
     /// Composite into RGBA16F (linear), for exact checks.
@@ -47,6 +49,7 @@ impl TestScene {
         Ok(Self {
             pattern: Pipeline::compute(ctx, "pattern.comp")?,
             blur: Pipeline::compute(ctx, "test_blur.comp")?,
+            alu: Pipeline::compute(ctx, "alu_heavy.comp")?,
             composite_rgba8: composite(vk::Format::R8G8B8A8_UNORM)?,
             composite_rgba16f: composite(HALF)?,
             sampler: Arc::new(Sampler::clamped(ctx, false)?),

@@ -254,6 +254,71 @@ fn render_writes_self_describing_report_trace_and_csv() {
 }
 
 #[test]
+fn counters_reach_the_table_report_csv_and_trace() {
+    let (json, trace, csv) = (tmp("k.json"), tmp("k-trace.json"), tmp("k.csv"));
+    let out = dermis(&[
+        "render",
+        "--scene",
+        "builtin",
+        "--out",
+        tmp("counters.png").to_str().unwrap(),
+        "--irradiance-res",
+        "256",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--ruler",
+        "--counters",
+        "--timings",
+        "--report",
+        json.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_no_validation_messages(&out);
+    assert!(stdout.contains("work counters per frame"), "{stdout}");
+    assert!(stdout.contains("bound by"), "{stdout}");
+    let read = |p: &PathBuf| std::fs::read_to_string(p).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    assert_eq!(r["fingerprint"]["counters"], true);
+    let copy = r["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "ruler_copy")
+        .unwrap();
+    assert_eq!(copy["counters"]["compute_invocations"], 256 * 256);
+    assert_eq!(copy["bound_by"]["bound"], "memory");
+    // The CSV's last column: the copy's invocations in every row of it.
+    let text = read(&csv);
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.contains(",ruler_copy,"))
+        .collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows.iter().all(|l| l.ends_with(",65536")), "{rows:?}");
+    let t: serde_json::Value = serde_json::from_str(&read(&trace)).unwrap();
+    let counters = t["traceEvents"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["ph"] == "C")
+        .count();
+    assert!(counters > 0, "no counter track");
+}
+
+#[test]
 fn info_json_describes_the_device() {
     let out = dermis(&["info", "--json"]);
     assert!(out.status.success());

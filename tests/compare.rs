@@ -171,6 +171,65 @@ fn runs_are_reported_and_a_known_regression_is_found() {
         .all(|m| m["latency"]["value"].as_f64().unwrap() > 0.0));
 }
 
+/// The report at `from` with one pass's measured times × `scale`.
+fn scaled_pass(from: &Path, to: &Path, pass: &str, scale: f64) {
+    let mut r: Value = serde_json::from_str(&std::fs::read_to_string(from).unwrap()).unwrap();
+    for f in r["per_frame"].as_array_mut().unwrap() {
+        for p in f["passes"].as_array_mut().unwrap() {
+            if p["name"] == pass {
+                let v = p["gpu_ns"].as_f64().unwrap();
+                p["gpu_ns"] = (v * scale).into();
+            }
+        }
+    }
+    r["run_id"] = "scaled".into();
+    std::fs::write(to, serde_json::to_string(&r).unwrap()).unwrap();
+}
+
+/// One pass ten times as slow, 4 runs a side: the t-test on log-times calls
+/// it (the rank test cannot: 2 / C(8, 4) = 0.029 > 0.05 / 16). Ten times,
+/// not the 3× of the synthetic study (src/profile/aa_study.rs): runs of this
+/// tiny scene scattered ±40 % while other builds shared the cores, and 4 runs
+/// of that cannot call 3×.
+#[test]
+fn a_slow_pass_is_called_from_four_runs_a_side() {
+    let base = tmp("four.json");
+    render_report(&base, 4, 256, &[]);
+    let new = tmp("four-skin10.json");
+    scaled_pass(&base, &new, "skin", 10.0);
+    let (b, n) = (base.to_str().unwrap(), new.to_str().unwrap());
+    let c: Value = serde_json::from_str(&ok(&dermis(&["compare", b, n, "--json"]))).unwrap();
+    let row = |name: &str| {
+        c["passes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    let skin = row("skin");
+    assert_eq!(skin["verdict"], "regressed", "{skin}");
+    assert_eq!(skin["test"], "welch-log", "{skin}");
+    assert_eq!(skin["base_samples"], 4);
+    // Only the frame's sum may have moved with it.
+    for p in c["passes"].as_array().unwrap() {
+        if p["name"] != "skin" && p["name"] != "frame (sum of passes)" {
+            assert_ne!(p["verdict"], "regressed", "{p}");
+        }
+    }
+    // Named, the pass is judged with the frame alone; the rest are shown.
+    let out = ok(&dermis(&["compare", b, n, "--passes", "skin"]));
+    assert!(out.contains("not in --passes"), "{out}");
+    let line = out.lines().find(|l| l.starts_with("skin ")).unwrap();
+    assert!(line.ends_with("regressed"), "{out}");
+    // A pass neither side ran is bad input, named.
+    let out = dermis(&["compare", b, n, "--passes", "skin,nosuch"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--passes: \"nosuch\""), "{err}");
+}
+
 #[test]
 fn different_work_is_refused_and_bad_files_are_named() {
     let (a, b) = (tmp("w256.json"), tmp("w512.json"));

@@ -127,6 +127,19 @@ fn rulers_and_per_texel_figures() {
     assert!((blur.ns_per_texel.unwrap() - ns).abs() < 1e-9 * ns.max(1.0));
     let copy = pass("ruler_copy").ns_per_texel.unwrap();
     assert!((blur.x_ruler.unwrap() - ns / copy).abs() < 1e-9 * (ns / copy));
+    // Bandwidth over the copy's: bytes / median, over the copy's bytes / median.
+    assert_eq!(pass("ruler_copy").of_ruler_bandwidth, Some(1.0));
+    let copy_gb = (2 * res * res * 8) as f64 / pass("ruler_copy").time.unwrap().median_ns;
+    let bw = (3 * res * res * 8) as f64 / blur.time.unwrap().median_ns / copy_gb;
+    assert!((blur.of_ruler_bandwidth.unwrap() - bw).abs() < 1e-9 * bw);
+    // The final pass samples the 256² levels at 64 × 48 pixels: it can touch
+    // one texel of each per pixel, not the whole level.
+    let skin = pass("skin");
+    assert!(
+        skin.touched_bytes.unwrap() < skin.bytes.unwrap(),
+        "{skin:?}"
+    );
+    assert_eq!(blur.touched_bytes, blur.bytes);
     // Screen passes count output pixels.
     assert_eq!(pass("skin").texels, Some(w as u64 * h as u64));
     assert!(r.table().contains("ns/texel") && r.table().contains("×ruler"));
@@ -134,5 +147,6 @@ fn rulers_and_per_texel_figures() {
     let r = report(false);
     assert!(r.passes.iter().all(|p| !p.name.starts_with("ruler_")));
     assert!(r.passes.iter().all(|p| p.x_ruler.is_none()));
+    assert!(r.passes.iter().all(|p| p.of_ruler_bandwidth.is_none()));
     assert!(r.passes.iter().any(|p| p.ns_per_texel.is_some()));
 }

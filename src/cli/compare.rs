@@ -28,6 +28,11 @@ pub struct DecideArgs {
     /// Compare even where the work differs (scene, mesh, view, sizes).
     #[arg(long)]
     allow_setup_change: bool,
+    /// The passes the change targets, comma-separated: only they and the
+    /// frame's sum are judged (Holm over them alone, so fewer runs decide);
+    /// the others are shown, not judged.
+    #[arg(long, value_delimiter = ',', value_name = "PASS,...")]
+    passes: Vec<String>,
     /// Print the comparison as JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -214,6 +219,7 @@ fn report_comparison(
         noise_threshold: decide.noise_threshold,
         significance: decide.significance,
         allow_setup_change: decide.allow_setup_change,
+        passes: decide.passes.clone(),
     };
     if pairs.is_empty() {
         return Err(dermis::Error::Input(format!(

@@ -69,11 +69,18 @@ pub struct RenderArgs {
     /// Print the compiled render graph (passes, barriers, lifetimes).
     #[arg(long)]
     dump_graph: bool,
-    /// Also time two ruler passes at the irradiance resolution (an RGBA16F copy,
-    /// `ruler_copy`, and a read, `ruler_read`) and report every pass's ns/texel
+    /// Also time three ruler passes at the irradiance resolution (an RGBA16F
+    /// copy, `ruler_copy`, a read, `ruler_read`, and one workgroup of the read,
+    /// `ruler_empty`) and report every pass's ns/texel
     /// as a multiple of the copy's (docs/performance.md).
     #[arg(long)]
     ruler: bool,
+    /// Count every pass's work with pipeline statistics queries (vertices,
+    /// primitives, vertex, fragment and compute invocations) into the timing
+    /// table, report, CSV and trace; needs the device's
+    /// pipelineStatisticsQuery feature (docs/performance.md, "Work counters").
+    #[arg(long)]
+    counters: bool,
 }
 
 #[derive(Args)]
@@ -115,6 +122,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         scene_path: Some(args.scene.path()?),
         progress: std::io::stderr().is_terminal(),
         ruler: args.ruler,
+        counters: args.counters,
         runs: args.runs,
         warmup: args.warmup,
         warmup_ms: args.warmup_ms,

@@ -33,6 +33,12 @@ impl<K: Hash + Eq, V: Clone> Memo<K, V> {
         Ok(v)
     }
 
+    /// Every value it holds, in no order.
+    pub fn values(&self) -> Vec<V> {
+        let map = self.map.lock().unwrap_or_else(|e| e.into_inner());
+        map.values().cloned().collect()
+    }
+
     /// How many values it holds.
     pub fn len(&self) -> usize {
         self.map.lock().unwrap_or_else(|e| e.into_inner()).len()
@@ -94,6 +100,19 @@ impl Pipelines {
     /// How many pipelines it has built.
     pub fn len(&self) -> usize {
         self.made.len()
+    }
+
+    /// Each pipeline's name and creation time (creation feedback), slowest
+    /// first; those the driver gave no time for are left out.
+    pub fn creation_times(&self) -> Vec<(String, f64)> {
+        let mut out: Vec<(String, f64)> = self
+            .made
+            .values()
+            .iter()
+            .filter_map(|p| Some((p.name.clone(), p.creation_ns?)))
+            .collect();
+        out.sort_by(|a, b| b.1.total_cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+        out
     }
 
     pub fn is_empty(&self) -> bool {

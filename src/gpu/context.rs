@@ -50,6 +50,13 @@ pub struct DeviceInfo {
     pub timestamps: bool,
     pub timestamp_period_ns: f32,
     pub timestamp_valid_bits: u32,
+    /// Pipeline statistics queries (the `pipelineStatisticsQuery` feature,
+    /// enabled on the device when offered): per-pass work counters.
+    pub pipeline_statistics: bool,
+    /// Calibrated timestamps (`VK_EXT_calibrated_timestamps` with the device
+    /// and CLOCK_MONOTONIC domains, enabled when offered): GPU timestamps on the
+    /// host's clock.
+    pub calibrated_timestamps: bool,
     pub max_image_dimension_2d: u32,
     pub memory_heaps: Vec<MemoryHeap>,
     pub validation: bool,
@@ -76,6 +83,7 @@ pub struct Context {
     pub physical: vk::PhysicalDevice,
     pub device: ash::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
+    calibrated: Option<ash::ext::calibrated_timestamps::Device>,
     queue: Mutex<vk::Queue>,
     /// Held by work that must not wait behind another thread's (see [`Context::foreground`]).
     foreground: Mutex<()>,
@@ -162,13 +170,14 @@ impl Context {
             messenger: messenger.as_ref(),
         };
         let swapchain = options.display.is_some();
-        let (physical, queue_family, info) = choose_device(
+        let (physical, queue_family, mut info) = choose_device(
             &instance,
             options.device.as_deref(),
             validation.is_some(),
             swapchain,
         )?;
-        let device = create_device(&instance, physical, queue_family, swapchain)?;
+        info.calibrated_timestamps = calibration_offered(&entry, &instance, physical);
+        let device = create_device(&instance, physical, queue_family, swapchain, &info)?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -194,6 +203,9 @@ impl Context {
                     .then(|| ash::ext::debug_utils::Device::new(&instance, &device))
             });
         let push_descriptor = ash::khr::push_descriptor::Device::new(&instance, &device);
+        let calibrated = info
+            .calibrated_timestamps
+            .then(|| ash::ext::calibrated_timestamps::Device::new(&instance, &device));
         log::info!(
             "device: {} ({}), driver {} {}, Vulkan {}",
             info.name,
@@ -210,6 +222,7 @@ impl Context {
             physical,
             device,
             push_descriptor,
+            calibrated,
             queue: Mutex::new(queue),
             foreground: Mutex::new(()),
             queue_family,
@@ -217,6 +230,28 @@ impl Context {
             info,
             validation,
         }))
+    }
+
+    /// The device's timestamp and the host's instant at one moment, with the
+    /// uncertainty in ns (the driver's maximum deviation plus the call's
+    /// length, the instant being the call's midpoint): what puts GPU
+    /// timestamps on the host's clock. `None` without calibrated timestamps.
+    pub fn calibrate(&self) -> Option<(u64, std::time::Instant, f64)> {
+        let ext = self.calibrated.as_ref()?;
+        let info = [
+            vk::CalibratedTimestampInfoEXT::default().time_domain(vk::TimeDomainEXT::DEVICE),
+            vk::CalibratedTimestampInfoEXT::default()
+                .time_domain(vk::TimeDomainEXT::CLOCK_MONOTONIC),
+        ];
+        let before = std::time::Instant::now();
+        let (stamps, deviation) = unsafe { ext.get_calibrated_timestamps(&info) }.ok()?;
+        let after = std::time::Instant::now();
+        let call = after - before;
+        Some((
+            stamps[0],
+            before + call / 2,
+            deviation as f64 + call.as_nanos() as f64,
+        ))
     }
 
     /// The validation log, when validation is on. Keep the `Arc` to read it after
@@ -515,6 +550,7 @@ fn device_info(
         .get(family as usize)
         .map_or(0, |f| f.timestamp_valid_bits);
     let mem = unsafe { instance.get_physical_device_memory_properties(pd) };
+    let features = unsafe { instance.get_physical_device_features(pd) };
     let heaps = mem.memory_heaps[..mem.memory_heap_count as usize]
         .iter()
         .map(|h| MemoryHeap {
@@ -533,10 +569,31 @@ fn device_info(
         timestamps: valid_bits > 0 && props.limits.timestamp_compute_and_graphics != 0,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamp_valid_bits: valid_bits,
+        pipeline_statistics: features.pipeline_statistics_query != 0,
+        calibrated_timestamps: false,
         max_image_dimension_2d: props.limits.max_image_dimension2_d,
         memory_heaps: heaps,
         validation,
     }
+}
+
+/// Whether the device offers `VK_EXT_calibrated_timestamps` with both the
+/// device's and CLOCK_MONOTONIC's domains (std's `Instant` on Linux).
+fn calibration_offered(
+    entry: &ash::Entry,
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+) -> bool {
+    let name = ash::ext::calibrated_timestamps::NAME;
+    let offered = unsafe { instance.enumerate_device_extension_properties(pd) }
+        .is_ok_and(|exts| exts.iter().any(|e| e.extension_name_as_c_str() == Ok(name)));
+    if !offered {
+        return false;
+    }
+    let ext = ash::ext::calibrated_timestamps::Instance::new(entry, instance);
+    unsafe { ext.get_physical_device_calibrateable_time_domains(pd) }.is_ok_and(|d| {
+        d.contains(&vk::TimeDomainEXT::DEVICE) && d.contains(&vk::TimeDomainEXT::CLOCK_MONOTONIC)
+    })
 }
 
 fn create_device(
@@ -544,7 +601,9 @@ fn create_device(
     pd: vk::PhysicalDevice,
     family: u32,
     swapchain: bool,
+    info: &DeviceInfo,
 ) -> Result<ash::Device> {
+    let pipeline_statistics = info.pipeline_statistics;
     let priorities = [1.0];
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(family)
@@ -553,12 +612,19 @@ fn create_device(
     if swapchain {
         extensions.push(ash::khr::swapchain::NAME.as_ptr());
     }
+    if info.calibrated_timestamps {
+        extensions.push(ash::ext::calibrated_timestamps::NAME.as_ptr());
+    }
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .dynamic_rendering(true);
+    // Enabling the feature costs nothing until a query is begun.
+    let features =
+        vk::PhysicalDeviceFeatures::default().pipeline_statistics_query(pipeline_statistics);
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
+        .enabled_features(&features)
         .enabled_extension_names(&extensions)
         .push_next(&mut f12)
         .push_next(&mut f13);

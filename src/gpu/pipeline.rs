@@ -66,6 +66,16 @@ pub struct Pipeline {
     pub stages: vk::ShaderStageFlags,
     /// Bindings, push-constant size and workgroup size, reflected from the SPIR-V.
     pub interface: ShaderLayout,
+    /// How long the driver took to create it (pipeline creation feedback,
+    /// core in Vulkan 1.3), where it said.
+    pub creation_ns: Option<f64>,
+}
+
+/// The feedback's duration, where the driver marked it valid.
+fn feedback_ns(f: &vk::PipelineCreationFeedback) -> Option<f64> {
+    f.flags
+        .contains(vk::PipelineCreationFeedbackFlags::VALID)
+        .then_some(f.duration as f64)
 }
 
 impl Pipeline {
@@ -106,6 +116,7 @@ impl Pipeline {
             bind_point,
             stages,
             interface,
+            creation_ns: None,
         };
         let ranges = [vk::PushConstantRange {
             stage_flags: stages,
@@ -151,15 +162,20 @@ impl Pipeline {
             .module(module.raw)
             .name(c"main")
             .specialization_info(&spec);
+        let mut feedback = vk::PipelineCreationFeedback::default();
+        let mut feedback_info = vk::PipelineCreationFeedbackCreateInfo::default()
+            .pipeline_creation_feedback(&mut feedback);
         let info = vk::ComputePipelineCreateInfo::default()
             .stage(stage)
-            .layout(p.layout);
+            .layout(p.layout)
+            .push_next(&mut feedback_info);
         p.raw = unsafe {
             ctx.device
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
         }
         .map_err(|(_, e)| e)
         .vk("vkCreateComputePipelines")?[0];
+        p.creation_ns = feedback_ns(&feedback);
         ctx.name(p.raw, shader);
         Ok(Arc::new(p))
     }
@@ -257,6 +273,9 @@ impl Pipeline {
             vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut feedback = vk::PipelineCreationFeedback::default();
+        let mut feedback_info = vk::PipelineCreationFeedbackCreateInfo::default()
+            .pipeline_creation_feedback(&mut feedback);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(desc.color_formats)
             .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
@@ -271,13 +290,15 @@ impl Pipeline {
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
             .layout(p.layout)
-            .push_next(&mut rendering);
+            .push_next(&mut rendering)
+            .push_next(&mut feedback_info);
         p.raw = unsafe {
             ctx.device
                 .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
         }
         .map_err(|(_, e)| e)
         .vk("vkCreateGraphicsPipelines")?[0];
+        p.creation_ns = feedback_ns(&feedback);
         ctx.name(p.raw, &name);
         Ok(Arc::new(p))
     }

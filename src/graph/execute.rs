@@ -1,12 +1,13 @@
 //! Recording and submitting compiled graphs: frames in flight, the transient
-//! image pool, per-pass debug labels and GPU timestamps.
+//! image pool, per-pass debug labels, GPU timestamps and, when asked for,
+//! pipeline statistics (work counters).
 
 use super::pass_cx::{PassCx, ResolvedImage};
 use super::plan::{Barrier, Plan, PoolState};
 use super::{Graph, Imported, LoadOp, ResourceKind};
 use crate::error::{Error, Result, VkResultExt};
 use crate::gpu::{full_range, Context, Image};
-use crate::profile::{FrameReport, PassTime, PassWork};
+use crate::profile::{CpuSpan, FrameReport, PassCounters, PassTime, PassWork};
 use ash::vk;
 use std::ffi::CString;
 use std::sync::Arc;
@@ -19,13 +20,16 @@ pub struct Compiled {
     graph: Graph,
 }
 
-/// Per frame in flight: command buffer, fence, timestamp queries.
+/// Per frame in flight: command buffer, fence, timestamp queries and pipeline
+/// statistics queries (one per pass, with counters on).
 struct FrameSlot {
     pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
     queries: vk::QueryPool,
     query_capacity: u32,
+    stats: vk::QueryPool,
+    stats_capacity: u32,
     in_flight: Option<InFlight>,
 }
 
@@ -34,6 +38,9 @@ struct InFlight {
     frame: u64,
     pass_names: Vec<String>,
     work: Vec<PassWork>,
+    counted: bool,
+    /// Record and submit, on the host clock from `host_epoch`.
+    spans: Vec<CpuSpan>,
     cpu_record_ns: f64,
     cpu_submit_ns: f64,
     _graph: Graph,
@@ -71,9 +78,24 @@ impl Clock {
     }
 }
 
+/// The statistics a pass's query counts, in the order their results come
+/// ([`PassCounters::from_raw`]). Geometry and tessellation counts are left out:
+/// no pass uses those stages.
+const STATISTICS: vk::QueryPipelineStatisticFlags = vk::QueryPipelineStatisticFlags::from_raw(
+    vk::QueryPipelineStatisticFlags::INPUT_ASSEMBLY_VERTICES.as_raw()
+        | vk::QueryPipelineStatisticFlags::INPUT_ASSEMBLY_PRIMITIVES.as_raw()
+        | vk::QueryPipelineStatisticFlags::VERTEX_SHADER_INVOCATIONS.as_raw()
+        | vk::QueryPipelineStatisticFlags::CLIPPING_INVOCATIONS.as_raw()
+        | vk::QueryPipelineStatisticFlags::CLIPPING_PRIMITIVES.as_raw()
+        | vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS.as_raw()
+        | vk::QueryPipelineStatisticFlags::COMPUTE_SHADER_INVOCATIONS.as_raw(),
+);
+
 pub struct Executor {
     ctx: Arc<Context>,
     clock: Clock,
+    /// Pipeline statistics per pass ([`Executor::set_counters`]).
+    counters: bool,
     slots: Vec<FrameSlot>,
     next: usize,
     frame: u64,
@@ -83,6 +105,9 @@ pub struct Executor {
     /// timestamp (GPU clock) and an instant (host clock).
     gpu_epoch: Option<u64>,
     host_epoch: Option<Instant>,
+    /// A GPU timestamp and the host instant of the same moment
+    /// (Context::calibrate), taken with the first frame on GPU timestamps.
+    calibration: Option<(u64, Instant)>,
     /// Submissions wait while another thread holds `Context::foreground`.
     background: bool,
 }
@@ -93,6 +118,7 @@ impl Executor {
         let mut ex = Executor {
             ctx: ctx.clone(),
             clock: Clock::auto(&ctx.info),
+            counters: false,
             slots: Vec::new(),
             next: 0,
             frame: 0,
@@ -100,6 +126,7 @@ impl Executor {
             pool_images: Vec::new(),
             gpu_epoch: None,
             host_epoch: None,
+            calibration: None,
             background: false,
         };
         for _ in 0..frames_in_flight.max(1) {
@@ -128,6 +155,22 @@ impl Executor {
         Ok(())
     }
 
+    /// Counts each pass's work with a pipeline statistics query (vertices,
+    /// primitives, vertex, fragment and compute invocations) around it, outside
+    /// its timestamps. Off by default: then no query is recorded. An error on a
+    /// device without the `pipelineStatisticsQuery` feature.
+    pub fn set_counters(&mut self, on: bool) -> Result<()> {
+        if on && !self.ctx.info.pipeline_statistics {
+            return Err(Error::Input(format!(
+                "{} has no pipeline statistics queries (the pipelineStatisticsQuery \
+                 feature): it cannot count a pass's work",
+                self.ctx.info.name
+            )));
+        }
+        self.counters = on;
+        Ok(())
+    }
+
     fn new_slot(&self) -> Result<FrameSlot> {
         let d = &self.ctx.device;
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -140,6 +183,8 @@ impl Executor {
             fence: vk::Fence::null(),
             queries: vk::QueryPool::null(),
             query_capacity: 0,
+            stats: vk::QueryPool::null(),
+            stats_capacity: 0,
             in_flight: None,
         };
         let alloc = vk::CommandBufferAllocateInfo::default()
@@ -169,6 +214,9 @@ impl Executor {
         unsafe {
             if slot.queries != vk::QueryPool::null() {
                 d.destroy_query_pool(slot.queries, None);
+            }
+            if slot.stats != vk::QueryPool::null() {
+                d.destroy_query_pool(slot.stats, None);
             }
             if slot.fence != vk::Fence::null() {
                 d.destroy_fence(slot.fence, None);
@@ -221,21 +269,37 @@ impl Executor {
             .iter()
             .map(|p| p.work.clone())
             .collect();
+        if self.counters {
+            self.ensure_stats(index, n as u32)?;
+        }
         if self.clock == Clock::HostFence {
             let mut report = self.run_isolated(index, &compiled, &images, &buffers, names, sync)?;
             report.set_work(&work);
+            if self.counters {
+                report.set_counters(&self.read_counters(index, n)?);
+            }
             self.frame += 1;
             return Ok(previous.or(Some(report)));
         }
         self.ensure_queries(index, 2 + 2 * n as u32)?;
+        if self.host_epoch.is_none() {
+            self.host_epoch = Some(started);
+            self.calibration = self.ctx.calibrate().map(|(ticks, at, _)| (ticks, at));
+        }
         self.record(index, &compiled, &images, &buffers, 0..n)?;
         let recorded = Instant::now();
         self.submit_slot(index, sync)?;
         let submitted = Instant::now();
+        let spans = vec![
+            self.span("record", None, started, recorded),
+            self.span("submit", None, recorded, submitted),
+        ];
         self.slots[index].in_flight = Some(InFlight {
             frame: self.frame,
             pass_names: names,
             work,
+            counted: self.counters,
+            spans,
             cpu_record_ns: (recorded - started).as_nanos() as f64,
             cpu_submit_ns: (submitted - recorded).as_nanos() as f64,
             _graph: compiled.graph,
@@ -243,6 +307,17 @@ impl Executor {
         self.frame += 1;
         self.next = (index + 1) % self.slots.len();
         Ok(previous)
+    }
+
+    /// A CPU span from `a` to `b` on the host clock from the epoch.
+    fn span(&self, what: &str, pass: Option<&str>, a: Instant, b: Instant) -> CpuSpan {
+        let epoch = self.host_epoch.unwrap_or(a);
+        CpuSpan {
+            what: what.into(),
+            pass: pass.map(str::to_string),
+            start_ns: a.saturating_duration_since(epoch).as_nanos() as f64,
+            dur_ns: b.saturating_duration_since(a).as_nanos() as f64,
+        }
     }
 
     fn submit_slot(&self, index: usize, sync: FrameSync) -> Result<()> {
@@ -294,6 +369,7 @@ impl Executor {
         let epoch = *self.host_epoch.get_or_insert(frame_start);
         let (mut record_ns, mut submit_ns) = (0.0, 0.0);
         let mut passes = Vec::with_capacity(names.len());
+        let mut spans = Vec::with_capacity(3 * names.len());
         let count = names.len().max(1);
         for i in 0..count {
             let t0 = Instant::now();
@@ -310,6 +386,10 @@ impl Executor {
             let t3 = Instant::now();
             record_ns += (t1 - t0).as_nanos() as f64;
             submit_ns += (t2 - t1).as_nanos() as f64;
+            let pass = names.get(i).map(String::as_str);
+            spans.push(self.span("record", pass, t0, t1));
+            spans.push(self.span("submit", pass, t1, t2));
+            spans.push(self.span("wait", pass, t2, t3));
             if let Some(name) = names.get(i) {
                 passes.push(PassTime {
                     name: name.clone(),
@@ -328,6 +408,8 @@ impl Executor {
             cpu_submit_ns: submit_ns,
             dropped_deltas: 0,
             clock: "host-fence".into(),
+            host_start_ns: Some((frame_start - epoch).as_nanos() as f64),
+            cpu_spans: spans,
             ..Default::default()
         })
     }
@@ -366,7 +448,9 @@ impl Executor {
         };
         let slot = &self.slots[index];
         let d = &self.ctx.device;
+        let wait_start = Instant::now();
         unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let wait = self.span("wait", None, wait_start, Instant::now());
         unsafe { d.reset_fences(&[slot.fence]) }.vk("vkResetFences")?;
         let mut report = if slot.queries != vk::QueryPool::null() {
             let mut raw = vec![0u64; 2 + 2 * done.pass_names.len()];
@@ -394,13 +478,25 @@ impl Executor {
                 bits => (1u64 << bits) - 1,
             };
             let ticks = raw[0].wrapping_sub(epoch) & mask;
-            report.start_ns = Some(ticks as f64 * info.timestamp_period_ns as f64);
+            let period = info.timestamp_period_ns as f64;
+            report.start_ns = Some(ticks as f64 * period);
+            // On the host clock: the calibration's instant, plus the ticks since.
+            if let (Some((at_ticks, at)), Some(host)) = (self.calibration, self.host_epoch) {
+                let since = (raw[0].wrapping_sub(at_ticks) & mask) as f64 * period;
+                report.host_start_ns =
+                    Some(at.saturating_duration_since(host).as_nanos() as f64 + since);
+            }
             report
         } else {
             // No timestamps on this device: passes are listed without GPU times.
             FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
         };
         report.set_work(&done.work);
+        report.cpu_spans = done.spans;
+        report.cpu_spans.push(wait);
+        if done.counted {
+            report.set_counters(&self.read_counters(index, done.pass_names.len())?);
+        }
         report.cpu_record_ns = done.cpu_record_ns;
         report.cpu_submit_ns = done.cpu_submit_ns;
         Ok(Some(report))
@@ -427,6 +523,44 @@ impl Executor {
         // Host reset (Vulkan 1.2 hostQueryReset): the slot's previous frame is retired.
         unsafe { d.reset_query_pool(slot.queries, 0, slot.query_capacity) };
         Ok(())
+    }
+
+    /// A pipeline statistics query per pass in the slot, host-reset.
+    fn ensure_stats(&mut self, index: usize, needed: u32) -> Result<()> {
+        let d = &self.ctx.device;
+        let slot = &mut self.slots[index];
+        if slot.stats_capacity < needed.max(1) {
+            if slot.stats != vk::QueryPool::null() {
+                unsafe { d.destroy_query_pool(slot.stats, None) };
+                slot.stats = vk::QueryPool::null();
+            }
+            let capacity = needed.next_power_of_two().max(32);
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                .pipeline_statistics(STATISTICS)
+                .query_count(capacity);
+            slot.stats = unsafe { d.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+            slot.stats_capacity = capacity;
+        }
+        unsafe { d.reset_query_pool(slot.stats, 0, slot.stats_capacity) };
+        Ok(())
+    }
+
+    /// The counters of the slot's `n` passes (their work has completed).
+    fn read_counters(&self, index: usize, n: usize) -> Result<Vec<PassCounters>> {
+        let mut raw = vec![[0u64; 7]; n];
+        if n > 0 {
+            unsafe {
+                self.ctx.device.get_query_pool_results(
+                    self.slots[index].stats,
+                    0,
+                    &mut raw,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+            }
+            .vk("vkGetQueryPoolResults")?;
+        }
+        Ok(raw.into_iter().map(PassCounters::from_raw).collect())
     }
 
     /// Creates images for pool slots that have none yet.
@@ -524,11 +658,18 @@ impl Executor {
         if first {
             timestamp(0);
         }
+        // Around the pass and its timestamps, after its barriers.
+        let counting = self.counters && slot.stats != vk::QueryPool::null();
         let cx = PassCx::new(&self.ctx, cmd, images, buffers);
         for i in range {
             let (planned, pass) = (&c.plan.passes[i], &c.graph.passes[i]);
             self.label_begin(cmd, &planned.name);
             self.barriers(cmd, &planned.barriers, images, buffers);
+            if counting {
+                unsafe {
+                    d.cmd_begin_query(cmd, slot.stats, i as u32, vk::QueryControlFlags::empty())
+                };
+            }
             timestamp(2 + 2 * i as u32);
             let rendering = !pass.attachments.is_empty();
             if rendering {
@@ -541,6 +682,9 @@ impl Executor {
                 unsafe { d.cmd_end_rendering(cmd) };
             }
             timestamp(3 + 2 * i as u32);
+            if counting {
+                unsafe { d.cmd_end_query(cmd, slot.stats, i as u32) };
+            }
             self.label_end(cmd);
         }
         if last {

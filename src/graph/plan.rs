@@ -178,7 +178,8 @@ impl PoolState {
 
 /// The pass's texels (declared, else the render area of its first attachment) and
 /// nominal traffic: every graph resource it uses counted once at full size (an
-/// image's first mip level).
+/// image's first mip level); and the traffic it can touch, each image capped at
+/// one texel per invocation.
 fn work(pass: &super::PassDecl, resources: &[PlannedResource]) -> PassWork {
     let texels = pass.texels.or_else(|| {
         let a = pass.attachments.first()?;
@@ -186,25 +187,29 @@ fn work(pass: &super::PassDecl, resources: &[PlannedResource]) -> PassWork {
         Some(d.width as u64 * d.height as u64)
     });
     let mut seen: Vec<usize> = Vec::new();
-    let mut bytes = 0;
+    let (mut bytes, mut touched_bytes) = (0, 0);
     for &(r, _) in &pass.uses {
         if seen.contains(&r) {
             continue;
         }
         seen.push(r);
         let res = &resources[r];
-        bytes += match (res.image, res.buffer_size) {
+        let (full, touched) = match (res.image, res.buffer_size) {
             (Some(d), _) => {
                 let texel = crate::gpu::texel_bytes(d.format).unwrap_or(0) as u64;
-                d.width as u64 * d.height as u64 * texel
+                let full = d.width as u64 * d.height as u64 * texel;
+                (full, texels.map_or(full, |t| full.min(t * texel)))
             }
-            (None, Some(size)) => size,
-            (None, None) => 0,
+            (None, Some(size)) => (size, size),
+            (None, None) => (0, 0),
         };
+        bytes += full;
+        touched_bytes += touched;
     }
     PassWork {
         texels,
         bytes,
+        touched_bytes,
         tags: pass.tags.clone(),
     }
 }

@@ -1,21 +1,22 @@
-//! `dermis compare`: whether a pass got slower between two measurements, with
-//! criterion.rs's rule — a change counts only when it is significant (Mann-
-//! Whitney U, Holm-corrected over the passes) **and** its whole bootstrap
-//! confidence interval lies beyond the noise threshold — and Chromium
-//! Pinpoint's third answer: inconclusive, measure more (with how much more).
+//! `dermis compare`: whether a pass got slower between two measurements, pass
+//! by pass, each judged by the rule of [`super::verdict`] (a significant
+//! change, Holm-corrected over the judged passes, whose whole interval lies
+//! beyond the noise threshold; else unchanged or inconclusive).
 //!
 //! Times are compared in ruler units where both sides timed the ruler (each
 //! frame's pass time over the same frame's `ruler_copy`), so that a busy
 //! machine, which slows both, cancels; else in ms.
 
-use super::bootstrap::relative_change_ci;
-use super::fingerprint::Fingerprint;
-use super::run::{is_ruler, RunReport, RULER_COPY, SCHEMA_VERSION};
-use super::significance::{holm, mann_whitney_p, smallest_p};
+pub use super::measurement::{check_report_schema, MeasuredFrame, Measurement, FRAME_ROW};
+pub use super::verdict::{Test, Verdict};
+
+use super::measurement::{join_split_passes, samples, setup_differences};
+use super::run::{is_ruler, RULER_COPY};
+use super::significance::holm;
 use super::stats::{median, Stats};
+use super::verdict::{evidence, more_samples, verdict};
 use crate::error::{Error, Result};
 use serde::Serialize;
-use std::collections::BTreeMap;
 
 /// The default noise threshold: the relative change below which a difference
 /// is not reported — the median |change| of passes of ≥ 5 ms between two
@@ -24,10 +25,6 @@ use std::collections::BTreeMap;
 pub const DEFAULT_NOISE_THRESHOLD: f64 = 0.06;
 /// Significance level of the Holm-corrected test (criterion.rs's default).
 pub const DEFAULT_SIGNIFICANCE: f64 = 0.05;
-/// Confidence level of the bootstrap interval.
-pub const CONFIDENCE: f64 = 0.95;
-/// The row of each frame's passes summed (rulers excluded).
-pub const FRAME_ROW: &str = "frame (sum of passes)";
 
 /// Setup keys whose difference changes the work itself: timings of such runs
 /// measure different things (an error unless allowed).
@@ -39,187 +36,6 @@ const WORKLOAD_KEYS: [&str; 6] = [
     "render_height",
     "irradiance_resolution",
 ];
-/// Setup keys that vary between identical runs (the metered exposure).
-const RUN_KEYS: [&str; 1] = ["exposure_ev"];
-
-/// One side of a comparison: the measured (post-warm-up) frames of one or
-/// more runs, and where they were measured.
-#[derive(Clone, Debug, Default)]
-pub struct Measurement {
-    /// The files it was read from.
-    pub source: String,
-    pub fingerprint: Fingerprint,
-    /// The setup as key → value text (RunSetup's JSON fields).
-    pub setup: BTreeMap<String, String>,
-    /// Pass names in first-seen order.
-    pub pass_order: Vec<String>,
-    /// Texels each pass computes (for × ruler).
-    pub texels: BTreeMap<String, u64>,
-    pub frames: Vec<MeasuredFrame>,
-}
-
-/// One measured frame: its run (a key unique across pooled reports) and
-/// each pass's time in ns.
-#[derive(Clone, Debug, Default)]
-pub struct MeasuredFrame {
-    pub run: String,
-    pub passes: BTreeMap<String, f64>,
-}
-
-/// Refuses what is not a run report this dermis reads: no `schema_version`
-/// (older than schema 2, or not a report), or a newer one than
-/// [`SCHEMA_VERSION`].
-pub fn check_report_schema(value: &serde_json::Value, source: &str) -> Result<()> {
-    match value.get("schema_version").and_then(|v| v.as_u64()) {
-        Some(v) if v > u64::from(SCHEMA_VERSION) => Err(Error::Input(format!(
-            "{source}: report schema {v} is newer than this dermis reads ({SCHEMA_VERSION})"
-        ))),
-        None if value.get("per_frame").is_some() => Err(Error::Input(format!(
-            "{source}: a report older than schema 2 (no fingerprint): render it again"
-        ))),
-        None => Err(Error::Input(format!(
-            "{source}: not a dermis run report (no schema_version)"
-        ))),
-        Some(_) => Ok(()),
-    }
-}
-
-impl Measurement {
-    /// The measured frames of a run report (schema 2 or later).
-    pub fn from_report(report: &RunReport, source: &str) -> Result<Self> {
-        if report.schema_version < 2 {
-            return Err(Error::Input(format!(
-                "{source}: report schema {} is older than 2 (no fingerprint): render it again",
-                report.schema_version
-            )));
-        }
-        let setup = flat_setup(&report.setup)?;
-        let frames = report
-            .measured()
-            .map(|f| MeasuredFrame {
-                run: format!("{}#{}", report.run_id, f.run),
-                passes: first_of_each(f),
-            })
-            .collect();
-        Ok(Self {
-            source: source.to_string(),
-            fingerprint: report.fingerprint.clone(),
-            setup,
-            pass_order: report.passes.iter().map(|p| p.name.clone()).collect(),
-            texels: report
-                .passes
-                .iter()
-                .filter_map(|p| Some((p.name.clone(), p.texels?)))
-                .collect(),
-            frames,
-        })
-    }
-
-    /// Reads a report (`--report FILE.json`) from its JSON text.
-    pub fn from_report_json(text: &str, source: &str) -> Result<Self> {
-        let value: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| Error::Input(format!("{source}: not JSON: {e}")))?;
-        check_report_schema(&value, source)?;
-        let report: RunReport = serde_json::from_value(value)
-            .map_err(|e| Error::Input(format!("{source}: not a dermis run report: {e}")))?;
-        Self::from_report(&report, source)
-    }
-
-    /// Several measurements of one configuration as one (e.g. one report per
-    /// process of an interleaved run): setups must agree; differing machines
-    /// are returned as warnings.
-    pub fn pool(parts: Vec<Measurement>) -> Result<(Self, Vec<String>)> {
-        let mut parts = parts.into_iter();
-        let mut all = parts
-            .next()
-            .ok_or_else(|| Error::Input("no measurement to pool".into()))?;
-        let mut warnings = Vec::new();
-        for m in parts {
-            let diff = setup_differences(&all.setup, &m.setup);
-            if !diff.is_empty() {
-                return Err(Error::Input(format!(
-                    "{} and {} were rendered with different setups ({}): pool only runs of one setup",
-                    all.source,
-                    m.source,
-                    diff.join(", ")
-                )));
-            }
-            for d in all.fingerprint.differences(&m.fingerprint) {
-                warnings.push(format!("{} vs {}: {d}", all.source, m.source));
-            }
-            for p in &m.pass_order {
-                if !all.pass_order.contains(p) {
-                    all.pass_order.push(p.clone());
-                }
-            }
-            all.texels.extend(m.texels);
-            all.frames.extend(m.frames);
-            all.source = format!("{}, {}", all.source, m.source);
-        }
-        Ok((all, warnings))
-    }
-
-    fn runs(&self) -> usize {
-        let mut runs: Vec<&str> = self.frames.iter().map(|f| f.run.as_str()).collect();
-        runs.sort_unstable();
-        runs.dedup();
-        runs.len()
-    }
-
-    fn has_ruler(&self) -> bool {
-        !self.frames.is_empty()
-            && self
-                .frames
-                .iter()
-                .all(|f| f.passes.contains_key(RULER_COPY))
-    }
-}
-
-/// Each pass's time in a frame; of two passes of one name the first, as the
-/// report's statistics take it (FrameReport::pass_ns).
-fn first_of_each(f: &super::FrameReport) -> BTreeMap<String, f64> {
-    let mut out = BTreeMap::new();
-    for p in &f.passes {
-        if let Some(ns) = p.gpu_ns.filter(|v| v.is_finite()) {
-            out.entry(p.name.clone()).or_insert(ns);
-        }
-    }
-    out
-}
-
-/// The setup's fields as text, for comparing setups.
-fn flat_setup(setup: &impl Serialize) -> Result<BTreeMap<String, String>> {
-    let value = serde_json::to_value(setup).map_err(|e| Error::Input(e.to_string()))?;
-    let mut out = BTreeMap::new();
-    if let serde_json::Value::Object(map) = value {
-        for (k, v) in map {
-            let text = match v {
-                serde_json::Value::String(s) => s,
-                other => other.to_string(),
-            };
-            out.insert(k, text);
-        }
-    }
-    Ok(out)
-}
-
-/// "kernel: deon7 → accurate" per differing key (run-to-run keys left out).
-fn setup_differences(a: &BTreeMap<String, String>, b: &BTreeMap<String, String>) -> Vec<String> {
-    let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
-    keys.into_iter()
-        .filter(|k| !RUN_KEYS.contains(&k.as_str()))
-        .filter_map(|k| {
-            let (x, y) = (a.get(k), b.get(k));
-            (x != y).then(|| {
-                format!(
-                    "{k}: {} → {}",
-                    x.map_or("–", String::as_str),
-                    y.map_or("–", String::as_str)
-                )
-            })
-        })
-        .collect()
-}
 
 /// What a pass's time is measured in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -240,7 +56,7 @@ fn scatter(v: &[f64]) -> Option<f64> {
 }
 
 /// How to decide.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize)]
 pub struct CompareOptions {
     pub unit: Unit,
     /// Relative change below which nothing is reported (0.06 = 6 %).
@@ -249,6 +65,10 @@ pub struct CompareOptions {
     pub significance: f64,
     /// Compare runs whose work differs (scene, view, sizes).
     pub allow_setup_change: bool,
+    /// The passes a change targets (`--passes`): only they and the frame's
+    /// sum are judged, Holm over them alone; the others are shown, not
+    /// judged. Empty: every pass is judged.
+    pub passes: Vec<String>,
 }
 
 impl Default for CompareOptions {
@@ -258,28 +78,7 @@ impl Default for CompareOptions {
             noise_threshold: DEFAULT_NOISE_THRESHOLD,
             significance: DEFAULT_SIGNIFICANCE,
             allow_setup_change: false,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Verdict {
-    Regressed,
-    Improved,
-    Unchanged,
-    /// The interval straddles the threshold, or too few samples to be
-    /// significant: measure more.
-    Inconclusive,
-}
-
-impl Verdict {
-    pub fn name(self) -> &'static str {
-        match self {
-            Verdict::Regressed => "regressed",
-            Verdict::Improved => "improved",
-            Verdict::Unchanged => "unchanged",
-            Verdict::Inconclusive => "inconclusive",
+            passes: Vec::new(),
         }
     }
 }
@@ -305,12 +104,21 @@ pub struct PassChange {
     pub change_ms: Option<f64>,
     pub ci_low: Option<f64>,
     pub ci_high: Option<f64>,
+    /// What gave `p` and the interval.
+    pub test: Test,
+    /// A sample stands out of its side's scatter (the t-test's assumption in
+    /// doubt: it costs power, not false alarms).
+    pub outlier: bool,
     pub p: f64,
-    /// Holm-adjusted over the compared passes (rulers are not in the family).
+    /// Holm-adjusted over the judged passes (the others are corrected among
+    /// themselves).
     pub p_holm: f64,
     pub verdict: Verdict,
     /// A ruler pass: shown, not judged.
     pub ruler: bool,
+    /// In the family whose verdicts count: not a ruler and, with `--passes`,
+    /// named there (or the frame's sum).
+    pub judged: bool,
     /// For an inconclusive pass: about how many more samples per side would
     /// decide it; `None` where no number would (the change sits on the threshold).
     pub more_samples: Option<usize>,
@@ -338,7 +146,7 @@ impl Comparison {
     pub fn count(&self, verdict: Verdict) -> usize {
         self.passes
             .iter()
-            .filter(|p| !p.ruler && p.verdict == verdict)
+            .filter(|p| p.judged && p.verdict == verdict)
             .count()
     }
 
@@ -372,22 +180,41 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
         .cloned()
         .collect();
     names.push(FRAME_ROW.into());
+    if let Some(missing) = opts.passes.iter().find(|p| !names.contains(p)) {
+        return Err(Error::Input(format!(
+            "--passes: {missing:?} is not a pass both sides ran (they share: {})",
+            names.join(", ")
+        )));
+    }
     let only_in_base = only(&base.pass_order, &new.pass_order);
     let only_in_new = only(&new.pass_order, &base.pass_order);
 
+    let judged = |name: &String| {
+        !is_ruler(name)
+            && (opts.passes.is_empty() || name == FRAME_ROW || opts.passes.contains(name))
+    };
+    let family = names.iter().filter(|n| judged(n)).count().max(1);
+    let others = (names.len() - family).max(1);
+    // Each family's intervals jointly at 1 − α (Bonferroni), as its p-values
+    // are corrected jointly.
     let mut rows: Vec<PassChange> = names
         .iter()
-        .map(|name| pass_change(base, new, name, ruler, by_run))
+        .map(|name| {
+            let m = if judged(name) { family } else { others };
+            let confidence = 1.0 - opts.significance / m as f64;
+            let mut r = pass_change(base, new, name, ruler, by_run, confidence);
+            r.judged = judged(name);
+            r
+        })
         .collect();
     holm_adjust(&mut rows);
-    let family = rows.iter().filter(|r| !r.ruler).count().max(1);
     for r in &mut rows {
         decide(r, opts, family);
     }
     Ok(Comparison {
         base: base.source.clone(),
         new: new.source.clone(),
-        options: *opts,
+        options: opts.clone(),
         warnings,
         setup_changes,
         passes: rows,
@@ -395,36 +222,6 @@ pub fn compare(base: &Measurement, new: &Measurement, opts: &CompareOptions) -> 
         only_in_new,
         joined,
     })
-}
-
-/// A pass `X` one side runs whole and the other as `X_u` then `X_v` (a blur
-/// level in one pass since issue 24, in two before): `side`'s two are joined,
-/// frame by frame, into one pass `X` in `X_u`'s place, counted at `X_v`'s
-/// texels (the level's), so the rows compare like with like. Returns what was
-/// joined.
-fn join_split_passes(side: &mut Measurement, other: &Measurement) -> Vec<String> {
-    let mut joined = Vec::new();
-    for name in &other.pass_order {
-        let (u, v) = (format!("{name}_u"), format!("{name}_v"));
-        let split = |m: &Measurement| m.pass_order.contains(&u) && m.pass_order.contains(&v);
-        if side.pass_order.contains(name) || !split(side) || split(other) {
-            continue;
-        }
-        for f in &mut side.frames {
-            if let (Some(a), Some(b)) = (f.passes.remove(&u), f.passes.remove(&v)) {
-                f.passes.insert(name.clone(), a + b);
-            }
-        }
-        side.pass_order.retain(|p| *p != v);
-        if let Some(p) = side.pass_order.iter_mut().find(|p| **p == u) {
-            *p = name.clone();
-        }
-        if let Some(t) = side.texels.get(&v).copied() {
-            side.texels.insert(name.clone(), t);
-        }
-        joined.push(format!("{name} = {u} + {v} in {}", side.source));
-    }
-    joined
 }
 
 /// The threshold and the level must be fractions.
@@ -559,6 +356,7 @@ fn pass_change(
     name: &str,
     ruler: bool,
     by_run: bool,
+    confidence: f64,
 ) -> PassChange {
     let ruler_pass = is_ruler(name);
     let in_ruler = ruler && !ruler_pass;
@@ -570,7 +368,8 @@ fn pass_change(
         samples(base, name, false, by_run),
         samples(new, name, false, by_run),
     );
-    let ci = relative_change_ci(&b, &n, CONFIDENCE);
+    let e = evidence(&b, &n, confidence);
+    let ci = e.change;
     let ms = |v: &[f64]| median(v).map(|x| x / 1e6);
     // ns/texel over the ruler's: the per-frame ratio scaled by the texels.
     let x_ruler = |m: &Measurement| {
@@ -595,19 +394,22 @@ fn pass_change(
             .map(|(n, b)| n / b - 1.0),
         ci_low: ci.map(|c| c.1),
         ci_high: ci.map(|c| c.2),
-        p: mann_whitney_p(&b, &n),
+        test: e.test,
+        outlier: e.outlier,
+        p: e.p,
         p_holm: 1.0,
         verdict: Verdict::Inconclusive,
         ruler: ruler_pass,
+        judged: false,
         more_samples: None,
     }
 }
 
-/// Holm over the judged rows; rulers are corrected on their own.
+/// Holm over the judged rows; the others are corrected on their own.
 fn holm_adjust(rows: &mut [PassChange]) {
-    for rulers in [false, true] {
+    for judged in [true, false] {
         let idx: Vec<usize> = (0..rows.len())
-            .filter(|&i| rows[i].ruler == rulers)
+            .filter(|&i| rows[i].judged == judged)
             .collect();
         let adj = holm(&idx.iter().map(|&i| rows[i].p).collect::<Vec<_>>());
         for (&i, a) in idx.iter().zip(adj) {
@@ -620,93 +422,18 @@ fn only(a: &[String], b: &[String]) -> Vec<String> {
     a.iter().filter(|n| !b.contains(n)).cloned().collect()
 }
 
-/// A pass's samples: per frame, or per run (the median of its frames), in ns
-/// or over the ruler — per frame the same frame's ruler; per run the run's
-/// median ruler, which is steadier than any one frame's. `FRAME_ROW` sums the
-/// non-ruler passes.
-fn samples(m: &Measurement, name: &str, in_ruler: bool, by_run: bool) -> Vec<f64> {
-    let ns = |f: &MeasuredFrame| -> Option<f64> {
-        if name == FRAME_ROW {
-            let v: f64 = f
-                .passes
-                .iter()
-                .filter(|(n, _)| !is_ruler(n))
-                .map(|(_, v)| v)
-                .sum();
-            (v > 0.0).then_some(v)
-        } else {
-            f.passes.get(name).copied()
-        }
-    };
-    let ruler = |f: &MeasuredFrame| f.passes.get(RULER_COPY).copied().filter(|&r| r > 0.0);
-    if !by_run {
-        return m
-            .frames
-            .iter()
-            .filter_map(|f| match in_ruler {
-                true => Some(ns(f)? / ruler(f)?),
-                false => ns(f),
-            })
-            .collect();
-    }
-    let mut runs: Vec<&str> = Vec::new();
-    for f in &m.frames {
-        if !runs.contains(&f.run.as_str()) {
-            runs.push(&f.run);
-        }
-    }
-    runs.iter()
-        .filter_map(|run| {
-            let frames = m.frames.iter().filter(|f| f.run == *run);
-            let time = median(&frames.clone().filter_map(ns).collect::<Vec<_>>())?;
-            match in_ruler {
-                true => Some(time / median(&frames.filter_map(ruler).collect::<Vec<_>>())?),
-                false => Some(time),
-            }
-        })
-        .collect()
-}
-
-/// criterion.rs's rule, with Pinpoint's "inconclusive".
+/// The verdict of a row, and for an inconclusive one how many more samples.
 fn decide(r: &mut PassChange, opts: &CompareOptions, family: usize) {
-    let t = opts.noise_threshold;
     let (Some(est), Some(lo), Some(hi)) = (r.change, r.ci_low, r.ci_high) else {
         r.verdict = Verdict::Inconclusive;
         return;
     };
-    let significant = r.p_holm < opts.significance;
-    r.verdict = if significant && lo > t {
-        Verdict::Regressed
-    } else if significant && hi < -t {
-        Verdict::Improved
-    } else if lo >= -t && hi <= t {
-        Verdict::Unchanged
-    } else {
-        Verdict::Inconclusive
-    };
-    if r.verdict != Verdict::Inconclusive {
-        return;
+    let t = opts.noise_threshold;
+    r.verdict = verdict((est, lo, hi), r.p_holm, t, opts.significance);
+    if r.verdict == Verdict::Inconclusive {
+        let n = r.base_samples.min(r.new_samples);
+        r.more_samples = more_samples(r.test, n, (est, lo, hi), t, opts.significance, family);
     }
-    // The interval shrinks as 1/√n: the n at which it would clear the
-    // threshold on the side the estimate is on, and at which the exact test
-    // could reach the corrected level.
-    let n = r.base_samples.min(r.new_samples).max(1);
-    let half = (hi - lo) / 2.0;
-    let margin = (est.abs() - t).abs();
-    if margin < 0.1 * t.max(1e-3) {
-        r.more_samples = None;
-        return;
-    }
-    let mut needed = (n as f64 * (half / margin).powi(2)).ceil() as usize;
-    if est.abs() > t {
-        let per_test = opts.significance / family as f64;
-        let mut k = n.max(2);
-        while smallest_p(k) >= per_test && k < 1000 {
-            k += 1;
-        }
-        needed = needed.max(k);
-    }
-    r.more_samples = Some(needed.saturating_sub(n).clamp(1, 100_000));
 }
 
 /// The comparison as a fixed-width table, then the verdicts' counts.
@@ -737,7 +464,7 @@ pub fn table(c: &Comparison) -> String {
         "new×r",
         "change",
         "95% CI",
-        "p",
+        "p (test)",
         "p (Holm)",
         "verdict"
     );
@@ -748,6 +475,8 @@ pub fn table(c: &Comparison) -> String {
         };
         let verdict = if r.ruler {
             format!("({}, ruler, ms)", r.verdict.name())
+        } else if !r.judged {
+            format!("({}, not in --passes)", r.verdict.name())
         } else {
             match (r.verdict, r.more_samples) {
                 (Verdict::Inconclusive, Some(k)) => {
@@ -768,7 +497,12 @@ pub fn table(c: &Comparison) -> String {
             xr(r.new_x_ruler),
             pct(r.change),
             ci,
-            p(r.p),
+            format!(
+                "{} {}{}",
+                p(r.p),
+                r.test.short(),
+                if r.outlier { "!" } else { "" }
+            ),
             p(r.p_holm),
             verdict
         );
@@ -781,7 +515,8 @@ pub fn table(c: &Comparison) -> String {
     let sample = c.passes.first().map_or("frame", |r| r.sample);
     s += &format!(
         "{} regressed, {} improved, {} unchanged, {} inconclusive (change in {unit}, \
-         one sample per {sample}; threshold ±{:.1} %, α = {} Holm-corrected)\n",
+         one sample per {sample}; threshold ±{:.1} %, α = {} Holm-corrected; \
+         t: Welch on log-times, U: Mann-Whitney, !: a run stands out)\n",
         c.count(Verdict::Regressed),
         c.count(Verdict::Improved),
         c.count(Verdict::Unchanged),
@@ -1053,19 +788,5 @@ mod tests {
         b.fingerprint.clock = "host-fence".into();
         a.fingerprint.clock = "gpu-timestamp".into();
         assert!(compare(&a, &b, &CompareOptions::default()).is_err());
-    }
-
-    #[test]
-    fn pooling_joins_runs_of_one_setup_only() {
-        let a = measurement(1, 3, |_, _| 1.0, |_, _| 1.0);
-        let mut b = measurement(1, 3, |_, _| 1.0, |_, _| 1.0);
-        for f in &mut b.frames {
-            f.run = "other".into();
-        }
-        let (all, warnings) = Measurement::pool(vec![a.clone(), b.clone()]).unwrap();
-        assert_eq!((all.frames.len(), all.runs()), (6, 2));
-        assert!(warnings.is_empty());
-        b.setup.insert("view".into(), "irradiance".into());
-        assert!(Measurement::pool(vec![a, b]).is_err());
     }
 }

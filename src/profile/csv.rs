@@ -1,10 +1,13 @@
 //! `--csv FILE`: one row per pass per frame, with the run's setup in every row so
-//! files of several runs concatenate (minus their headers) into one table.
+//! files of several runs concatenate (minus their headers) into one table. The
+//! work counters (`render --counters`) come last, empty when not counted.
 
 use super::run::RunReport;
 
 pub const HEADER: &str = "run_id,run,frame,warmup,pass,start_ns,duration_ns,clock,\
-scene,environment,irradiance_resolution,kernel,chain,view,width,height,device,git_commit";
+scene,environment,irradiance_resolution,kernel,chain,view,width,height,device,git_commit,\
+input_vertices,input_primitives,vertex_invocations,clipping_invocations,clipping_primitives,\
+fragment_invocations,compute_invocations";
 
 /// RFC 4180 quoting where a field needs it.
 pub fn field(s: &str) -> String {
@@ -39,8 +42,23 @@ pub fn csv(report: &RunReport) -> String {
     out.push('\n');
     for f in &report.per_frame {
         for p in &f.passes {
+            let counters = p.counters.map_or_else(
+                || ",".repeat(6),
+                |c| {
+                    format!(
+                        "{},{},{},{},{},{},{}",
+                        c.input_vertices,
+                        c.input_primitives,
+                        c.vertex_invocations,
+                        c.clipping_invocations,
+                        c.clipping_primitives,
+                        c.fragment_invocations,
+                        c.compute_invocations
+                    )
+                },
+            );
             out += &format!(
-                "{},{},{},{},{},{},{},{},{run}\n",
+                "{},{},{},{},{},{},{},{},{run},{counters}\n",
                 field(&report.run_id),
                 f.run,
                 f.frame,
@@ -73,10 +91,15 @@ mod tests {
             lines[3],
             format!(
                 "{},0,1,false,a,10,10,host-fence,default,sky,256,deon7,full,final,64,48,\
-                 \"test device, 2 cores\",{GIT_COMMIT}",
+                 \"test device, 2 cores\",{GIT_COMMIT},,,,,,,",
                 r.run_id
             )
         );
+        let columns = HEADER.split(',').count();
+        // The device name's comma is inside quotes: one more piece per row.
+        assert!(lines[1..]
+            .iter()
+            .all(|l| l.split(',').count() == columns + 1));
         let id = &r.run_id;
         assert!(
             lines[1].starts_with(&format!("{id},0,0,true,a,10,30,")),
@@ -88,6 +111,17 @@ mod tests {
             "{}",
             lines[6]
         );
+    }
+
+    #[test]
+    fn counters_fill_the_last_columns() {
+        let mut r = report(&[30.0]);
+        r.per_frame[0].passes[0].counters = Some(crate::profile::PassCounters::from_raw([
+            3, 1, 3, 1, 2, 96, 0,
+        ]));
+        let text = csv(&r);
+        let row = text.lines().nth(1).unwrap();
+        assert!(row.ends_with(",3,1,3,1,2,96,0"), "{row}");
     }
 
     #[test]

@@ -71,7 +71,7 @@ pub fn bencher(r: &RunReport) -> Value {
 /// out), failed where it regressed; improved, unchanged and inconclusive passes
 /// pass, with the verdict in their system-out.
 pub fn junit(comparisons: &[&Comparison]) -> String {
-    let judged = |c: &Comparison| c.passes.iter().filter(|p| !p.ruler).count();
+    let judged = |c: &Comparison| c.passes.iter().filter(|p| p.judged).count();
     let failed = |c: &Comparison| c.count(Verdict::Regressed);
     let pct = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{:+.2}%", 100.0 * v));
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
@@ -87,7 +87,7 @@ pub fn junit(comparisons: &[&Comparison]) -> String {
             judged(c),
             failed(c)
         );
-        for p in c.passes.iter().filter(|p| !p.ruler) {
+        for p in c.passes.iter().filter(|p| p.judged) {
             let summary = format!(
                 "{}: change {} (95% CI [{}, {}]) in {} units, p = {:.3e} (Holm {:.3e}), {} vs {} {}s",
                 p.verdict.name(),

@@ -24,6 +24,10 @@ pub struct Fingerprint {
     pub clock: String,
     /// The Khronos validation layer was on (it costs CPU time per call).
     pub validation: bool,
+    /// Work counters were recorded around every pass (`render --counters`);
+    /// false in reports written before they existed.
+    #[serde(default)]
+    pub counters: bool,
 }
 
 impl Fingerprint {
@@ -41,6 +45,7 @@ impl Fingerprint {
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             clock: String::new(),
             validation: device.validation,
+            counters: false,
         }
     }
 
@@ -76,6 +81,11 @@ impl Fingerprint {
                 "validation",
                 self.validation.to_string(),
                 other.validation.to_string(),
+            ),
+            (
+                "counters",
+                self.counters.to_string(),
+                other.counters.to_string(),
             ),
         ]
         .into_iter()

@@ -1,20 +1,29 @@
 //! Frame reports: per-pass GPU time and start within the frame, CPU record/submit
 //! time; run reports with statistics over warmed-up frames; trace and CSV output.
 
+#[cfg(test)]
+mod aa_study;
 mod bootstrap;
+mod bound;
 pub mod compare;
+mod counters;
 pub mod csv;
 pub mod export;
 pub mod fingerprint;
+mod measurement;
 mod run;
 mod significance;
 mod stats;
 pub mod trace;
+mod ttest;
+mod verdict;
 
+pub use bound::{Bound, BoundBy};
+pub use counters::PassCounters;
 pub use fingerprint::Fingerprint;
 pub use run::{
-    is_ruler, CameraSetup, MemoryUse, PassStats, RunReport, RunSetup, GIT_COMMIT, GIT_DIRTY,
-    RULER_COPY, RULER_READ, SCHEMA_VERSION, VERSION,
+    is_ruler, CameraSetup, MemoryUse, PassStats, PipelineTime, RunReport, RunSetup, GIT_COMMIT,
+    GIT_DIRTY, RULER_COPY, RULER_EMPTY, RULER_READ, SCHEMA_VERSION, VERSION,
 };
 pub use stats::Stats;
 
@@ -29,6 +38,9 @@ use serde::{Deserialize, Serialize};
 pub struct PassWork {
     pub texels: Option<u64>,
     pub bytes: u64,
+    /// `bytes` with each image capped at one texel per invocation: what a pass
+    /// that samples a large image at few points can touch of it.
+    pub touched_bytes: u64,
     pub tags: Vec<&'static str>,
 }
 
@@ -40,6 +52,9 @@ pub struct PassTime {
     pub texels: Option<u64>,
     /// Nominal traffic (see [`PassWork`]).
     pub bytes: Option<u64>,
+    /// Traffic it can touch (see [`PassWork`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touched_bytes: Option<u64>,
     /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tags: Vec<String>,
@@ -48,6 +63,22 @@ pub struct PassTime {
     /// From the frame's start (first timestamp, or host start with host fences)
     /// to the pass's start.
     pub start_ns: Option<f64>,
+    /// Pipeline statistics (`render --counters`); absent when not counted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub counters: Option<PassCounters>,
+}
+
+/// A span of the CPU's work for a frame, on the host's clock.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CpuSpan {
+    /// `record`, `submit` or `wait` (for the frame's fence).
+    pub what: String,
+    /// The pass it was for, where one submission per pass (host fences).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pass: Option<String>,
+    /// From the executor's first frame's host start.
+    pub start_ns: f64,
+    pub dur_ns: f64,
 }
 
 /// What one frame cost.
@@ -72,6 +103,15 @@ pub struct FrameReport {
     pub dropped_deltas: u32,
     /// What measured the passes: "gpu-timestamp" or "host-fence".
     pub clock: String,
+    /// The frame's start on the host's clock, from the executor's first
+    /// frame's host start — the clock of `cpu_spans`: GPU timestamps put on
+    /// it by calibrated timestamps, or the host clock itself with host fences.
+    /// `None` where the clocks are not aligned.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host_start_ns: Option<f64>,
+    /// The CPU's record, submit and wait spans for this frame.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cpu_spans: Vec<CpuSpan>,
 }
 
 impl FrameReport {
@@ -85,6 +125,7 @@ impl FrameReport {
         for (p, w) in self.passes.iter_mut().zip(work) {
             p.texels = w.texels;
             p.bytes = Some(w.bytes);
+            p.touched_bytes = Some(w.touched_bytes);
             p.tags = w.tags.iter().map(|t| t.to_string()).collect();
         }
     }
@@ -147,6 +188,13 @@ impl FrameReport {
         }
     }
 
+    /// Attaches each pass's counters, in pass order.
+    pub fn set_counters(&mut self, counters: &[PassCounters]) {
+        for (p, c) in self.passes.iter_mut().zip(counters) {
+            p.counters = Some(*c);
+        }
+    }
+
     pub fn pass_start_ns(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|p| p.name == name)?.start_ns
     }
@@ -163,12 +211,19 @@ impl FrameReport {
                 name: p.name.clone(),
                 texels: p.texels,
                 bytes: p.bytes,
+                touched_bytes: p.touched_bytes,
                 tags: p.tags.clone(),
                 gpu_ns: med(frames.iter().filter_map(|f| f.pass_ns(&p.name)).collect()),
                 start_ns: med(frames
                     .iter()
                     .filter_map(|f| f.pass_start_ns(&p.name))
                     .collect()),
+                counters: PassCounters::median(
+                    &frames
+                        .iter()
+                        .filter_map(|f| f.pass(&p.name)?.counters)
+                        .collect::<Vec<_>>(),
+                ),
             })
             .collect();
         Some(FrameReport {

@@ -1,8 +1,9 @@
 //! What `--report FILE.json` writes: what was run, where, and what it cost.
 
+use super::bound::{bound_by, BoundBy, PassFigures};
 use super::fingerprint::{run_id, timestamp, Fingerprint};
 use super::stats::Stats;
-use super::{FrameReport, PassTime};
+use super::{FrameReport, PassCounters, PassTime};
 use crate::gpu::DeviceInfo;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -110,16 +111,27 @@ pub struct MemoryUse {
     pub reserved_bytes: u64,
 }
 
+/// How long the driver took to create one of the render's pipelines
+/// (pipeline creation feedback).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct PipelineTime {
+    /// Its shaders (`vertex+fragment` for graphics pipelines).
+    pub name: String,
+    pub creation_ns: f64,
+}
+
 /// The pass whose cost per texel every other pass is compared with (render's
 /// `--ruler`: a plain RGBA16F copy at the irradiance resolution).
 pub const RULER_COPY: &str = "ruler_copy";
 /// The read ruler's pass name (render::ruler).
 pub const RULER_READ: &str = "ruler_read";
+/// The empty ruler's pass name: one invocation, the cost of a pass itself.
+pub const RULER_EMPTY: &str = "ruler_empty";
 
 /// Whether a pass is a ruler: by name, so that reports written before passes
 /// carried tags are read the same way.
 pub fn is_ruler(name: &str) -> bool {
-    name == RULER_COPY || name == RULER_READ
+    name == RULER_COPY || name == RULER_READ || name == RULER_EMPTY
 }
 
 /// One pass (or the frame span) over the measured frames.
@@ -141,9 +153,34 @@ pub struct PassStats {
     pub gb_per_s: Option<f64>,
     /// ns/texel as a multiple of the copy ruler's in the same run.
     pub x_ruler: Option<f64>,
+    /// Traffic it can touch: each image it uses capped at one texel per
+    /// invocation (a screen pass sampling a 4096² level at its pixels touches
+    /// those, not the level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touched_bytes: Option<u64>,
+    /// Touched bytes per ns as a fraction of the copy ruler's in the same run:
+    /// how close the pass comes to what a plain copy achieves (> 1: caches
+    /// serve some of it, or it touches less than it declares).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub of_ruler_bandwidth: Option<f64>,
+    /// What bounds the pass (profile::bound), where the rulers ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound_by: Option<BoundBy>,
     /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tags: Vec<String>,
+    /// Pipeline statistics (`render --counters`), each the median over the
+    /// measured frames; absent when not counted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub counters: Option<PassCounters>,
+    /// Fragment invocations per pixel of the render area (covered share ×
+    /// over-shading), from the counters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fragments_per_pixel: Option<f64>,
+    /// Compute invocations per texel, from the counters (> 1: workgroups
+    /// overhang the image).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub invocations_per_texel: Option<f64>,
     /// The measured frames' times in frame order, `None` where a frame did not
     /// time it (`dermis compare` resamples these).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -169,12 +206,21 @@ impl PassStats {
         self.tags = work.map(|p| p.tags.clone()).unwrap_or_default();
         self.texels = texels;
         self.bytes = bytes;
+        self.touched_bytes = work.and_then(|p| p.touched_bytes);
         self.ns_per_texel = median
             .zip(texels.filter(|&t| t > 0))
             .map(|(t, n)| t / n as f64);
         self.gb_per_s = median
             .zip(bytes.filter(|&b| b > 0))
             .map(|(t, b)| b as f64 / t);
+        self
+    }
+
+    /// Fills the counters (their per-frame median) and what they say per texel.
+    fn with_counters(mut self, counters: Option<PassCounters>) -> Self {
+        self.counters = counters;
+        self.fragments_per_pixel = counters.and_then(|c| c.fragments_per_pixel(self.texels));
+        self.invocations_per_texel = counters.and_then(|c| c.invocations_per_texel(self.texels));
         self
     }
 }
@@ -230,6 +276,10 @@ pub struct RunReport {
     /// validation off.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation_messages: Option<u32>,
+    /// The last run's cached pipelines, once per render: how long the driver
+    /// took to create each (creation feedback), slowest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pipelines: Vec<PipelineTime>,
 }
 
 impl RunReport {
@@ -264,15 +314,40 @@ impl RunReport {
             .map(|n| {
                 let v = measured.iter().map(|f| f.pass_ns(n)).collect();
                 let work = measured.iter().rev().find_map(|f| f.pass(n));
-                PassStats::of(n, v).with_work(work)
+                let counted: Vec<PassCounters> = measured
+                    .iter()
+                    .filter_map(|f| f.pass(n)?.counters)
+                    .collect();
+                PassStats::of(n, v)
+                    .with_work(work)
+                    .with_counters(PassCounters::median(&counted))
             })
             .collect();
-        let ruler = passes
-            .iter()
-            .find(|p| p.name == RULER_COPY)
-            .and_then(|p| p.ns_per_texel);
+        let ruler = passes.iter().find(|p| p.name == RULER_COPY);
+        // Touched bytes per ns.
+        let touched = |p: &PassStats| {
+            let (t, b) = (p.time?.median_ns, p.touched_bytes?);
+            (t > 0.0).then(|| b as f64 / t)
+        };
+        let (ruler_ns, ruler_gb) = (ruler.and_then(|p| p.ns_per_texel), ruler.and_then(touched));
         for p in &mut passes {
-            p.x_ruler = p.ns_per_texel.zip(ruler).map(|(a, r)| a / r);
+            p.x_ruler = p.ns_per_texel.zip(ruler_ns).map(|(a, r)| a / r);
+            p.of_ruler_bandwidth = touched(p).zip(ruler_gb).map(|(a, r)| a / r);
+        }
+        let empty_ns = passes
+            .iter()
+            .find(|p| p.name == RULER_EMPTY)
+            .and_then(|p| p.time)
+            .map(|t| t.median_ns);
+        for p in &mut passes {
+            p.bound_by = p.time.and_then(|t| {
+                bound_by(&PassFigures {
+                    median_ns: t.median_ns,
+                    empty_ns,
+                    of_ruler_bandwidth: p.of_ruler_bandwidth,
+                    counters: p.counters,
+                })
+            });
         }
         let spans = measured.iter().map(|f| f.gpu_frame_ns).collect();
         let first_run = per_frame.first().map_or(0, |f| f.run);
@@ -288,6 +363,9 @@ impl RunReport {
         fingerprint.clock = per_frame
             .first()
             .map_or_else(|| "none".into(), |f| f.clock.clone());
+        fingerprint.counters = per_frame
+            .iter()
+            .any(|f| f.passes.iter().any(|p| p.counters.is_some()));
         let mut runs: Vec<u32> = per_frame.iter().map(|f| f.run).collect();
         runs.dedup();
         Self {
@@ -316,6 +394,7 @@ impl RunReport {
             warmup_only,
             per_frame,
             validation_messages: device.validation.then(crate::gpu::validation_messages),
+            pipelines: Vec::new(),
         }
     }
 
@@ -393,7 +472,8 @@ impl RunReport {
     }
 
     /// Per pass: median, min, max, p90 over the measured frames, and their count;
-    /// texels, ns per texel, GB/s of nominal traffic and × the copy ruler.
+    /// texels, ns per texel, GB/s of nominal traffic, × the copy ruler (time
+    /// per texel) and the fraction of the copy's bandwidth (BW/r).
     pub fn table(&self) -> String {
         let ms = |ns: Option<f64>| ns.map_or("n/a".to_string(), |v| format!("{:.3}", v / 1e6));
         let row = |name: &str, frames: usize, t: Option<Stats>| {
@@ -413,18 +493,19 @@ impl RunReport {
             |v: Option<f64>, digits: usize| v.map_or(String::new(), |v| format!("{v:.digits$}"));
         let mut s =
             format!(
-            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>6} {:>10} {:>9} {:>7} {:>7}   (ms; clock: {})\n",
+            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>6} {:>10} {:>9} {:>7} {:>7} {:>6}   (ms; clock: {})\n",
             "pass", "median", "min", "max", "p90", "mean", "std", "frames", "texels", "ns/texel",
-            "GB/s", "×ruler", self.fingerprint.clock
+            "GB/s", "×ruler", "BW/r", self.fingerprint.clock
         );
         for p in &self.passes {
             s += &format!(
-                "{} {:>10} {:>9} {:>7} {:>7}\n",
+                "{} {:>10} {:>9} {:>7} {:>7} {:>6}\n",
                 row(&p.name, p.frames, p.time),
                 p.texels.map_or(String::new(), |t| t.to_string()),
                 opt(p.ns_per_texel, 2),
                 opt(p.gb_per_s, 2),
                 opt(p.x_ruler, 2),
+                opt(p.of_ruler_bandwidth, 2),
             );
         }
         let sum: f64 = self
@@ -464,9 +545,41 @@ impl RunReport {
                 once.join(", ")
             );
         }
+        if !self.pipelines.is_empty() {
+            let total: f64 = self.pipelines.iter().map(|p| p.creation_ns).sum();
+            let slowest: Vec<String> = self
+                .pipelines
+                .iter()
+                .take(3)
+                .map(|p| format!("{} {:.1}", p.name, p.creation_ns / 1e6))
+                .collect();
+            s += &format!(
+                "pipelines (once per render): {} created in {:.1} ms; slowest (ms): {}\n",
+                self.pipelines.len(),
+                total / 1e6,
+                slowest.join(", ")
+            );
+        }
         let dropped: u32 = measured.iter().map(|f| f.dropped_deltas).sum();
         if dropped > 0 {
             s += &format!("({dropped} non-positive timestamp deltas dropped)\n");
+        }
+        s += &self.counters_table();
+        let bound: Vec<String> = self
+            .passes
+            .iter()
+            .filter_map(|p| {
+                let b = p.bound_by.as_ref()?;
+                Some(format!(
+                    "  {:<22} {:<15} {}\n",
+                    p.name,
+                    b.bound.name(),
+                    b.why
+                ))
+            })
+            .collect();
+        if !bound.is_empty() {
+            s += &format!("bound by (docs/pass-analysis.md):\n{}", bound.concat());
         }
         let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
         s += &format!(
@@ -475,6 +588,40 @@ impl RunReport {
             mib(self.memory.allocated_bytes),
             mib(self.memory.reserved_bytes)
         );
+        s
+    }
+}
+
+impl RunReport {
+    /// The passes' work counters (per frame, medians), when counted: empty
+    /// otherwise.
+    pub fn counters_table(&self) -> String {
+        if self.passes.iter().all(|p| p.counters.is_none()) {
+            return String::new();
+        }
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.3}"));
+        let mut s = format!(
+            "{:<24} {:>10} {:>10} {:>10} {:>10} {:>12} {:>8} {:>12} {:>9}   (work counters per frame)\n",
+            "pass", "vertices", "VS inv", "prims in", "prims out", "fragments", "frag/px",
+            "compute inv", "inv/texel"
+        );
+        for p in &self.passes {
+            let Some(c) = p.counters else {
+                continue;
+            };
+            s += &format!(
+                "{:<24} {:>10} {:>10} {:>10} {:>10} {:>12} {:>8} {:>12} {:>9}\n",
+                p.name,
+                c.input_vertices,
+                c.vertex_invocations,
+                c.clipping_invocations,
+                c.clipping_primitives,
+                c.fragment_invocations,
+                opt(p.fragments_per_pixel),
+                c.compute_invocations,
+                opt(p.invocations_per_texel),
+            );
+        }
         s
     }
 }
@@ -525,6 +672,8 @@ pub(super) mod tests {
             timestamps: true,
             timestamp_period_ns: 1.0,
             timestamp_valid_bits: 64,
+            pipeline_statistics: true,
+            calibrated_timestamps: false,
             max_image_dimension_2d: 8192,
             memory_heaps: Vec::new(),
             validation: false,

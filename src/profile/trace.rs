@@ -1,12 +1,22 @@
 //! `--trace FILE.json`: the run as Chrome trace events (Perfetto, chrome://tracing).
 //! One track per clock; on it a slice for the run, one per frame at the frame's
 //! start, and one per pass at frame start + the pass's start offset, so passes
-//! nest in their frame and frames in the run.
+//! nest in their frame and frames in the run. Where the frames carry their
+//! start on the host's clock (calibrated GPU timestamps, or host fences), the
+//! frames go there and a second track holds the CPU's record, submit and wait
+//! spans: one timeline. Work counters (`--counters`) are
+//! in each pass's arguments and on counter tracks (fragment and compute
+//! invocations: the pass's count from its start, 0 from its end).
 
 use super::run::RunReport;
 use serde_json::{json, Value};
 
 const PID: u32 = 1;
+/// The CPU track's thread id (the queue's tracks count from 1).
+const CPU_TID: u32 = 100;
+/// The counter tracks' names.
+const FRAGMENTS: &str = "fragment invocations";
+const INVOCATIONS: &str = "compute invocations";
 
 /// `ts` and `dur` in µs of a slice from `begin` to `end` ns, both rounded to whole
 /// ns first: a pass that ends with its frame keeps ending with it (no nesting
@@ -29,8 +39,18 @@ pub fn trace(report: &RunReport) -> Value {
         "name": "process_name", "ph": "M", "pid": PID, "tid": 0,
         "args": { "name": format!("dermis {} ({}) on {}", report.dermis_version, report.git_commit, report.fingerprint.device) },
     })];
+    let aligned = report.per_frame.iter().any(|f| f.host_start_ns.is_some());
+    if aligned {
+        events.push(json!({
+            "name": "thread_name", "ph": "M", "pid": PID, "tid": CPU_TID,
+            "args": { "name": "CPU: record, submit, wait (host clock)" },
+        }));
+    }
     for c in &clocks {
         let name = match *c {
+            "gpu-timestamp" if aligned => {
+                "queue 0: GPU timestamps on the host clock (calibrated)".to_string()
+            }
             "gpu-timestamp" => "queue 0: GPU timestamps".to_string(),
             "host-fence" => "queue 0: host clock, submit to fence per pass".to_string(),
             other => format!("queue 0: {other}"),
@@ -42,6 +62,7 @@ pub fn trace(report: &RunReport) -> Value {
     }
     // Frames without a start (no timestamps) follow the previous one.
     let mut slices = Vec::new();
+    let mut counters = Vec::new();
     let mut cursor = 0.0f64;
     let mut run_end = 0.0f64;
     // Each run's clock starts again at 0: runs follow one another.
@@ -50,7 +71,22 @@ pub fn trace(report: &RunReport) -> Value {
         if i > 0 && f.run != report.per_frame[i - 1].run {
             run_base = run_end;
         }
-        let start = f.start_ns.map_or(cursor, |s| run_base + s);
+        let start = match f.host_start_ns.filter(|_| aligned) {
+            Some(h) => run_base + h,
+            None => f.start_ns.map_or(cursor, |s| run_base + s),
+        };
+        for c in f.cpu_spans.iter().filter(|_| aligned) {
+            let (ts, dur) = ts_dur(run_base + c.start_ns, run_base + c.start_ns + c.dur_ns);
+            run_end = run_end.max(run_base + c.start_ns + c.dur_ns);
+            let name = match &c.pass {
+                Some(p) => format!("{} {p}", c.what),
+                None => c.what.clone(),
+            };
+            slices.push(json!({
+                "name": name, "cat": "cpu", "ph": "X", "pid": PID, "tid": CPU_TID,
+                "ts": ts, "dur": dur, "args": { "run": f.run, "frame": f.frame },
+            }));
+        }
         let pass_end = f
             .passes
             .iter()
@@ -73,10 +109,25 @@ pub fn trace(report: &RunReport) -> Value {
                 continue;
             };
             let (ts, dur_us) = ts_dur(start + offset, start + offset + dur);
+            let mut args = json!({ "run": f.run, "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur });
+            if let Some(c) = &p.counters {
+                args["counters"] = json!(c);
+                for (name, value) in [
+                    (FRAGMENTS, c.fragment_invocations),
+                    (INVOCATIONS, c.compute_invocations),
+                ] {
+                    for (t, v) in [(ts, value), (ts + dur_us, 0)] {
+                        counters.push(json!({
+                            "name": name, "cat": "counter", "ph": "C", "pid": PID, "ts": t,
+                            "args": { name: v },
+                        }));
+                    }
+                }
+            }
             slices.push(json!({
                 "name": p.name, "cat": "pass", "ph": "X",
                 "pid": PID, "tid": tid(&f.clock), "ts": ts, "dur": dur_us,
-                "args": { "run": f.run, "frame": f.frame, "start_in_frame_ns": offset, "duration_ns": dur },
+                "args": args,
             }));
         }
     }
@@ -97,6 +148,7 @@ pub fn trace(report: &RunReport) -> Value {
         }));
     }
     events.extend(slices);
+    events.extend(counters);
     json!({ "traceEvents": events, "displayTimeUnit": "ns" })
 }
 
@@ -191,6 +243,75 @@ mod tests {
             (pass["ts"].as_f64(), pass["dur"].as_f64()),
             (Some(1.006), Some(0.005))
         );
+    }
+
+    #[test]
+    fn counters_are_pass_arguments_and_counter_tracks() {
+        let mut r = report(&[30.0]);
+        r.per_frame[0].passes[0].counters = Some(crate::profile::PassCounters {
+            fragment_invocations: 96,
+            compute_invocations: 7,
+            ..Default::default()
+        });
+        let t = trace(&r);
+        let pass = slices(&t, "pass")[0];
+        assert_eq!(pass["args"]["counters"]["fragment_invocations"], 96);
+        assert!(slices(&t, "pass")[1]["args"].get("counters").is_none());
+        let c = slices(&t, "counter");
+        assert_eq!(c.len(), 4);
+        // The fragments' track: 96 from the pass's start, 0 from its end.
+        let (p0, p1) = span(pass);
+        assert_eq!(c[0]["ph"], "C");
+        assert_eq!(c[0]["name"], FRAGMENTS);
+        assert_eq!(
+            (c[0]["ts"].as_f64().unwrap(), &c[0]["args"][FRAGMENTS]),
+            (p0, &json!(96))
+        );
+        assert_eq!(
+            (c[1]["ts"].as_f64().unwrap(), &c[1]["args"][FRAGMENTS]),
+            (p1, &json!(0))
+        );
+        assert_eq!(c[2]["args"][INVOCATIONS], 7);
+    }
+
+    #[test]
+    fn host_clock_frames_and_cpu_spans_share_the_timeline() {
+        let mut r = report(&[30.0]);
+        let f = &mut r.per_frame[0];
+        // GPU timestamps say 1000; calibrated, the frame began at 5000 on the host.
+        f.start_ns = Some(1000.0);
+        f.host_start_ns = Some(5000.0);
+        f.cpu_spans = vec![
+            crate::profile::CpuSpan {
+                what: "record".into(),
+                start_ns: 4000.0,
+                dur_ns: 500.0,
+                ..Default::default()
+            },
+            crate::profile::CpuSpan {
+                what: "wait".into(),
+                start_ns: 4600.0,
+                dur_ns: 500.0,
+                ..Default::default()
+            },
+        ];
+        let t = trace(&r);
+        assert_eq!(span(slices(&t, "frame")[0]).0, 5.0);
+        let cpu = slices(&t, "cpu");
+        assert_eq!(cpu.len(), 2);
+        assert!(cpu.iter().all(|e| e["tid"] == CPU_TID));
+        assert_eq!(
+            (cpu[1]["name"].as_str(), span(cpu[1])),
+            (Some("wait"), (4.6, 5.1))
+        );
+        let names: Vec<_> = t["traceEvents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e["ph"] == "M")
+            .map(|e| e["args"]["name"].as_str().unwrap().to_string())
+            .collect();
+        assert!(names.iter().any(|n| n.starts_with("CPU")), "{names:?}");
     }
 
     #[test]

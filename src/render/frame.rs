@@ -442,6 +442,11 @@ impl Frame {
     }
 
     /// Bright sources taken out of the environment as lights.
+    /// Each cached pipeline's creation time, slowest first (gpu::Pipelines).
+    pub(super) fn pipeline_times(&self) -> Vec<(String, f64)> {
+        self.pipelines.creation_times()
+    }
+
     pub(super) fn extracted_lights(&self) -> usize {
         self.lighting.extracted.len()
     }

@@ -20,7 +20,7 @@ use crate::light::reference::{render_view_with, ReferenceImage, Settings as Refe
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::profile::{CameraSetup, MemoryUse, RunReport, RunSetup};
+use crate::profile::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
 use crate::scene::checker;
 use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
@@ -47,6 +47,9 @@ pub struct RenderOptions {
     pub progress: bool,
     /// Time the rulers (render::ruler) in every frame.
     pub ruler: bool,
+    /// Count every pass's work (pipeline statistics) in every frame
+    /// (graph::Executor::set_counters).
+    pub counters: bool,
     /// Independent repetitions, each with a fresh upload, pipelines and warm-up;
     /// the image is the last run's.
     pub runs: u32,
@@ -99,6 +102,7 @@ impl Default for RenderOptions {
             scene_path: None,
             progress: false,
             ruler: false,
+            counters: false,
             runs: 1,
             warmup: None,
             warmup_ms: None,
@@ -238,6 +242,13 @@ pub fn render_scene(
         }
     }
     let warmup = opts.warmup_frames()?;
+    if opts.counters && !ctx.info.pipeline_statistics {
+        return Err(Error::Input(format!(
+            "--counters: {} offers no pipeline statistics queries (the \
+             pipelineStatisticsQuery feature); render without --counters",
+            ctx.info.name
+        )));
+    }
     let skin = settings(ctx, scene)?;
     if opts.view == View::Screen(Screen::Reference) {
         return reference(ctx, scene, opts);
@@ -263,7 +274,7 @@ pub fn render_scene(
     }
     let mut out = last.expect("at least one run");
     let r = &out.report;
-    let preroll_ms = r.preroll_ms;
+    let (preroll_ms, pipelines) = (r.preroll_ms, r.pipelines.clone());
     out.report = RunReport::new(
         &ctx.info,
         r.setup.clone(),
@@ -273,6 +284,7 @@ pub fn render_scene(
         r.memory,
     );
     out.report.preroll_ms = preroll_ms;
+    out.report.pipelines = pipelines;
     Ok(out)
 }
 
@@ -424,6 +436,7 @@ fn run(
     let exposure_readback = Readback::new(ctx, "readback exposure", meter::RESULT_BYTES)?;
 
     let mut executor = Executor::new(ctx, 2)?;
+    executor.set_counters(opts.counters)?;
     let mut reports = Vec::new();
     let mut plan = String::new();
     let mut gpu_metered = false;
@@ -516,6 +529,11 @@ fn run(
     let warmup = opts.warmup_frames()? as usize;
     let mut report = RunReport::new(&ctx.info, run_setup, (w, h), reports, warmup, memory);
     report.preroll_ms = preroll.as_millis() as u64;
+    report.pipelines = frame
+        .pipeline_times()
+        .into_iter()
+        .map(|(name, creation_ns)| PipelineTime { name, creation_ns })
+        .collect();
     Ok(RenderOutput {
         width: w,
         height: h,
@@ -587,6 +605,8 @@ mod tests {
             timestamps: true,
             timestamp_period_ns: 1.0,
             timestamp_valid_bits: 64,
+            pipeline_statistics: true,
+            calibrated_timestamps: false,
             max_image_dimension_2d: 8192,
             memory_heaps: Vec::new(),
             validation: false,
