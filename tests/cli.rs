@@ -14,6 +14,23 @@ fn dermis(args: &[&str]) -> Output {
         .expect("dermis runs")
 }
 
+/// `render` at 32 × 32 with a 256² irradiance texture: the smallest frame
+/// the tests of the command line need.
+const SMALL_RENDER: [&str; 7] = [
+    "render",
+    "--width",
+    "32",
+    "--height",
+    "32",
+    "--irradiance-res",
+    "256",
+];
+
+/// [`dermis`] of [`SMALL_RENDER`] and `args`.
+fn small_render(args: &[&str]) -> Output {
+    dermis(&[&SMALL_RENDER[..], args].concat())
+}
+
 fn tmp(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("dermis-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -661,16 +678,9 @@ fn exposures_beyond_floats_are_refused_and_an_empty_frame_is_said() {
         "environment uniform:100000,100000,100000 is too bright: its radiance reaches 1.0000e5",
     );
     for mm in ["1e-6", "1e6"] {
-        let out = dermis(&[
-            "render",
+        let out = small_render(&[
             "--out",
             tmp("off-screen.png").to_str().unwrap(),
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--irradiance-res",
-            "256",
             "--mm-per-unit",
             mm,
         ]);
@@ -686,16 +696,9 @@ fn exposures_beyond_floats_are_refused_and_an_empty_frame_is_said() {
         );
     }
     // A given exposure far too low: the image is black, and that is said.
-    let out = dermis(&[
-        "render",
+    let out = small_render(&[
         "--out",
         tmp("black.png").to_str().unwrap(),
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--irradiance-res",
-        "256",
         "--exposure",
         "-60",
     ]);
@@ -1164,15 +1167,7 @@ fn paths_that_are_not_utf8_are_written() {
     let png = dir.join(std::ffi::OsStr::from_bytes(b"o\xff.png"));
     let json = dir.join(std::ffi::OsStr::from_bytes(b"r\xff.json"));
     let out = Command::new(env!("CARGO_BIN_EXE_dermis"))
-        .args([
-            "render",
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--irradiance-res",
-            "256",
-        ])
+        .args(SMALL_RENDER)
         .arg("--out")
         .arg(&png)
         .arg("--report")
@@ -1204,19 +1199,11 @@ fn an_interrupted_write_leaves_no_temporary() {
     };
     let render = |dir: &std::path::Path, name: &str, pause: bool| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_dermis"));
-        c.args([
-            "render",
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--irradiance-res",
-            "256",
-        ])
-        .arg("--out")
-        .arg(dir.join(name))
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null());
+        c.args(SMALL_RENDER)
+            .arg("--out")
+            .arg(dir.join(name))
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null());
         if pause {
             c.env(dermis::atomic::TEST_PAUSE_VAR, "60000");
         }

@@ -25,7 +25,7 @@ pub struct Medium {
 /// Jensen, Marschner, Levoy & Hanrahan 2001, "A Practical Model for Subsurface
 /// Light Transport", Fig. 5: (σs′, σa) in mm⁻¹, R G B (as tabulated in pbrt's
 /// `GetMediumScatteringProperties`).
-const JENSEN_2001: [(MediumPreset, [f32; 3], [f32; 3]); 8] = [
+const JENSEN_2001: [(MediumPreset, [f32; 3], [f32; 3]); 7] = [
     (
         MediumPreset::JensenSkin1,
         [0.74, 0.88, 1.01],
@@ -61,7 +61,6 @@ const JENSEN_2001: [(MediumPreset, [f32; 3], [f32; 3]); 8] = [
         [0.18, 0.07, 0.03],
         [0.061, 0.97, 1.45],
     ),
-    (MediumPreset::Deon2007, [0.0; 3], [0.0; 3]),
 ];
 
 impl Medium {

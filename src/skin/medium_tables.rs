@@ -4,6 +4,7 @@
 //! through a slab by thickness, T(d), as a table the translucent pass reads.
 
 use crate::atomic::write_atomic;
+use crate::cache::{fnv1a64, hex};
 use crate::skin::fit::{fit_profile, fit_reference, Fit};
 use crate::skin::medium::Medium;
 use crate::skin::profile::{Gaussian, Profile};
@@ -226,11 +227,7 @@ pub fn cache_key(medium: &Medium) -> String {
         "v{VERSION};{};{RADIAL_PHOTONS};{RADIAL_BINS};{SLAB_SAMPLES};{SLAB_COUNT};{SLAB_MAX_PHOTONS};{GAUSSIANS};{COLLISION_BUDGET};{TAIL_SHARE}",
         medium.key()
     );
-    // FNV-1a 64.
-    let h = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    format!("{h:016x}")
+    hex(fnv1a64(text.as_bytes()))
 }
 
 #[cfg(test)]

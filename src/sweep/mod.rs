@@ -5,7 +5,6 @@
 
 pub mod compare;
 pub mod diffusion;
-pub mod hash;
 pub mod interleave;
 pub mod lighting;
 pub mod log;
@@ -187,7 +186,7 @@ fn render(
 /// FNV-1a 64 over the reference's final then diffuse image, as f32 bytes in
 /// memory order (little-endian on every platform dermis runs on).
 pub fn reference_checksum(final_image: &[f32], diffuse: &[f32]) -> String {
-    hash::hex(hash::fnv1a64_parts([
+    crate::cache::hex(crate::cache::fnv1a64_parts([
         bytemuck::cast_slice::<f32, u8>(final_image),
         bytemuck::cast_slice::<f32, u8>(diffuse),
     ]))

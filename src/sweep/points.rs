@@ -2,9 +2,9 @@
 //! sweep hash: one number over everything that makes two runs' points
 //! comparable (and two shards' points parts of one sweep).
 
-use super::hash::{fnv1a64, hex};
 use super::shard::Shard;
 use super::{name, SweepOptions, Variant};
+use crate::cache::{fnv1a64, hex};
 use crate::scene::file::{Chain, Kernel};
 use serde::Serialize;
 

@@ -5,7 +5,7 @@
 //! `I/N` is `hash:I/N`: a retried or extended sweep keeps its assignment.
 //! `auto` reads the index and total from the job scheduler's environment.
 
-use super::hash::fnv1a64;
+use crate::cache::fnv1a64;
 use crate::error::{Error, Result};
 use std::fmt;
 

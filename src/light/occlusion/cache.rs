@@ -11,17 +11,7 @@ use glam::Vec3;
 use super::transfer::{RgbTransfer, Transfer};
 use crate::scene::mesh::Mesh;
 
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
-
-/// FNV-1a 64 (Fowler, Noll & Vo), continuing from state `h`.
-fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(FNV_PRIME);
-    }
-    h
-}
+use crate::cache::{fnv1a64_from as fnv1a, hex, FNV_OFFSET};
 
 /// Stable cache key (16 hex digits) of the mesh's positions, normals and
 /// indices, the occlusion `method` and its `settings` string. Each field is
@@ -54,7 +44,7 @@ pub fn cache_key(mesh: &Mesh, method: &str, settings: &str) -> String {
         h = fnv1a(h, &(s.len() as u64).to_le_bytes());
         h = fnv1a(h, s.as_bytes());
     }
-    format!("{h:016x}")
+    hex(h)
 }
 
 pub use crate::cache::default_cache_dir;
