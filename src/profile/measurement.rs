@@ -246,7 +246,7 @@ pub(super) fn samples(m: &Measurement, name: &str, in_ruler: bool, by_run: bool)
 }
 
 /// A pass `X` one side runs whole and the other as `X_u` then `X_v` (a blur
-/// level in one pass since issue 24, in two before): `side`'s two are joined,
+/// level one build blurs in one stencil pass, another in two): `side`'s two are joined,
 /// frame by frame, into one pass `X` in `X_u`'s place, counted at `X_v`'s
 /// texels (the level's), so the rows compare like with like. Returns what was
 /// joined.
