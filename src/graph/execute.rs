@@ -106,8 +106,9 @@ pub struct Executor {
     gpu_epoch: Option<u64>,
     host_epoch: Option<Instant>,
     /// A GPU timestamp and the host instant of the same moment
-    /// (Context::calibrate), taken with the first frame on GPU timestamps.
-    calibration: Option<(u64, Instant)>,
+    /// (Context::calibrate), taken with the first frame on GPU timestamps,
+    /// and how far apart they may be, ns.
+    calibration: Option<(u64, Instant, f64)>,
     /// Submissions wait while another thread holds `Context::foreground`.
     background: bool,
 }
@@ -141,6 +142,13 @@ impl Executor {
     /// submission per pass on CPU devices, between passes).
     pub fn set_background(&mut self) {
         self.background = true;
+    }
+
+    /// How far GPU times put on the host clock may be off, ns: the
+    /// calibration's uncertainty (Context::calibrate); `None` before the first
+    /// frame or without calibrated timestamps.
+    pub fn calibration_uncertainty_ns(&self) -> Option<f64> {
+        self.calibration.map(|(_, _, u)| u)
     }
 
     /// Overrides the automatic choice; `GpuTimestamp` needs device timestamps.
@@ -284,7 +292,7 @@ impl Executor {
         self.ensure_queries(index, 2 + 2 * n as u32)?;
         if self.host_epoch.is_none() {
             self.host_epoch = Some(started);
-            self.calibration = self.ctx.calibrate().map(|(ticks, at, _)| (ticks, at));
+            self.calibration = self.ctx.calibrate();
         }
         self.record(index, &compiled, &images, &buffers, 0..n)?;
         let recorded = Instant::now();
@@ -481,7 +489,7 @@ impl Executor {
             let period = info.timestamp_period_ns as f64;
             report.start_ns = Some(ticks as f64 * period);
             // On the host clock: the calibration's instant, plus the ticks since.
-            if let (Some((at_ticks, at)), Some(host)) = (self.calibration, self.host_epoch) {
+            if let (Some((at_ticks, at, _)), Some(host)) = (self.calibration, self.host_epoch) {
                 let since = (raw[0].wrapping_sub(at_ticks) & mask) as f64 * period;
                 report.host_start_ns =
                     Some(at.saturating_duration_since(host).as_nanos() as f64 + since);
