@@ -109,6 +109,7 @@ fn scene(mesh: Mesh, lights: Vec<Light>, env: EnvMap) -> Scene {
         env,
         camera: Camera::orbit_at(Vec3::ZERO, 0.0, 0.0, 400.0, 30.0),
         lights,
+        pre_exposure: dermis::scene::range::PreExposure::NONE,
         file,
     }
 }

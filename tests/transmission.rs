@@ -173,6 +173,7 @@ fn scene(d: f32, light: LightSource, transmission: f32) -> Scene {
             shadow: true,
             angular_radius: 0.0,
         }],
+        pre_exposure: dermis::scene::range::PreExposure::NONE,
         file,
     }
 }

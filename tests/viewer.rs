@@ -144,7 +144,7 @@ fn the_viewer_ends_and_writes_its_screenshot_in_tiny_windows() {
         };
         let mut stderr = String::new();
         std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
-        assert!(status.success(), "{w}×{h}: {stderr}");
+        assert!(status.success(), "{w}×{h}: {status}; stderr: {stderr}");
         assert!(!stderr.contains("[validation]"), "{w}×{h}:\n{stderr}");
         let img = image::open(&shot).expect("the screenshot").to_rgba8();
         let (iw, ih) = img.dimensions();

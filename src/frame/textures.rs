@@ -25,11 +25,12 @@ pub fn upload_rgba8(ctx: &Arc<Context>, name: &str, t: &Texture) -> Result<Arc<I
 /// The environment as RGBA32F: the sky's sun disk (~1e6 kcd/m²) does not fit
 /// in half floats (max 65504). With a full mip chain where the device filters
 /// RGBA32F (the specular prefilter reads coarse levels), else one level.
-pub fn upload_env(ctx: &Arc<Context>, env: &EnvMap) -> Result<Arc<Image>> {
+/// Texels × `scale` (the scene's map pre-exposure, scene::range).
+pub fn upload_env(ctx: &Arc<Context>, env: &EnvMap, scale: f32) -> Result<Arc<Image>> {
     let texels: Vec<f32> = env
         .texels
         .iter()
-        .flat_map(|c| [c.x, c.y, c.z, 1.0])
+        .flat_map(|c| [c.x * scale, c.y * scale, c.z * scale, 1.0])
         .collect();
     let format = vk::Format::R32G32B32A32_SFLOAT;
     let desc = ImageDesc {

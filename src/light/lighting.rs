@@ -11,6 +11,7 @@ use crate::frame::MAX_LIGHTS;
 use crate::scene::camera::Camera;
 use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
+use crate::scene::range::PreExposure;
 use crate::scene::{Light, LightSource, Scene};
 use glam::Vec3;
 use std::hash::{Hash, Hasher};
@@ -26,6 +27,8 @@ pub struct Lighting {
     /// `environment.rotation_deg`, `environment.intensity`.
     pub rotation_deg: f32,
     pub intensity: f32,
+    /// The scene's pre-exposure: `lights` hold it already.
+    pub pre_exposure: PreExposure,
     /// `skin.occlusion` is not off.
     pub occlusion: bool,
     /// `render.shadow_resolution`.
@@ -55,6 +58,7 @@ impl Lighting {
             extracted,
             rotation_deg: env.rotation_deg,
             intensity: env.intensity,
+            pre_exposure: scene.pre_exposure,
             occlusion: scene.file.skin.occlusion != Occlusion::Off,
             shadow_resolution: scene.file.render.shadow_resolution,
             scene_lights: scene.lights.clone(),
@@ -90,9 +94,15 @@ impl Lighting {
         changed
     }
 
-    /// What the SH projection is computed from (rotation, intensity).
+    /// The factor the GPU scales the uploaded map by: intensity · P / M.
+    pub fn env_factor(&self) -> f32 {
+        let p = self.pre_exposure;
+        (f64::from(self.intensity) * f64::from(p.lighting) / f64::from(p.map)) as f32
+    }
+
+    /// What the SH projection is computed from (rotation, the map's factor).
     pub fn sh_key(&self) -> u64 {
-        key(&[self.rotation_deg, self.intensity])
+        key(&[self.rotation_deg, self.env_factor()])
     }
 
     /// Atlas tiles a shadowed light takes: its whole map, and its focus map
@@ -130,17 +140,25 @@ impl Lighting {
     }
 
     /// The scene's lights, then the extracted sources as shadowed directional
-    /// lights of their power, turned and scaled like the environment.
+    /// lights of their power, turned and scaled like the environment; all
+    /// pre-exposed.
     fn frame_lights(&self) -> Vec<Light> {
+        let p = self.pre_exposure.lighting;
         let all: Vec<Light> = self
             .scene_lights
             .iter()
-            .copied()
+            .map(|l| Light {
+                irradiance: l.irradiance * p,
+                ..*l
+            })
             .chain(self.extracted.iter().map(|x| Light {
                 source: LightSource::Directional(x.world_direction(self.rotation_deg)),
                 // A uniform cap of radius α delivers (1 + cos α)/2 of its ∫L dω to a
                 // surface facing it.
-                irradiance: x.power * self.intensity * 0.5 * (1.0 + x.angular_radius_rad.cos()),
+                irradiance: x.power
+                    * (f64::from(self.intensity) * f64::from(p)) as f32
+                    * 0.5
+                    * (1.0 + x.angular_radius_rad.cos()),
                 shadow: true,
                 angular_radius: x.angular_radius_rad,
             }))

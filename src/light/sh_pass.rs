@@ -157,7 +157,7 @@ pub fn project(
     rotation_deg: f32,
     intensity: f32,
 ) -> Result<(Sh9, FrameReport)> {
-    let image = upload_env(ctx, env)?;
+    let image = upload_env(ctx, env, 1.0)?;
     let passes = ShPasses::new(
         &Pipelines::new(ctx),
         Arc::new(Sampler::clamped(ctx, false)?),

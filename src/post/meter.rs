@@ -54,6 +54,15 @@ impl Metered {
         }
     }
 
+    /// What a metering of an image × 2^`pre_ev` says of the image itself.
+    pub fn pre_exposed_by(self, pre_ev: f32) -> Metered {
+        Metered {
+            ev: self.ev + pre_ev,
+            log_average: self.log_average * (-pre_ev).exp2(),
+            ..self
+        }
+    }
+
     /// The GPU's result buffer as read back.
     pub fn from_bytes(bytes: &[u8]) -> Metered {
         let v: &[f32] = bytemuck::cast_slice(&bytes[..RESULT_BYTES as usize]);

@@ -80,7 +80,7 @@ fn frame_uniforms(
         light_focus_tile: [[0.0; 4]; MAX_LIGHTS],
         env: [
             lighting.rotation_deg.to_radians(),
-            lighting.intensity,
+            lighting.env_factor(),
             0.0,
             if lighting.occlusion { 1.0 } else { 0.0 },
         ],
@@ -153,7 +153,7 @@ fn frame_inputs(
     skin: &SkinSettings,
 ) -> Result<FrameInputs> {
     let samplers = Arc::new(Samplers::new(ctx)?);
-    let env = upload_env(ctx, &scene.env)?;
+    let env = upload_env(ctx, &scene.env, scene.pre_exposure.map)?;
     let (lights, views) = (&lighting.lights, &lighting.maps);
     // Bit i set where light i has `has`.
     let bits = |has: &dyn Fn(usize) -> bool| {
@@ -228,7 +228,7 @@ fn frame_inputs(
             }),
         },
         lighting_env: match residual {
-            Some(r) => upload_env(ctx, r)?,
+            Some(r) => upload_env(ctx, r, scene.pre_exposure.map)?,
             None => env.clone(),
         },
         env,
@@ -422,14 +422,14 @@ impl Frame {
             skin.resolution
         );
         let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
-        let (rotation, intensity) = (lighting.rotation_deg, lighting.intensity);
+        let (rotation, factor) = (lighting.rotation_deg, lighting.env_factor());
         let pipelines = Pipelines::new(ctx);
         Ok(Self {
             tables,
             passes: Passes::new(&pipelines, scene, &inputs, &lighting, &skin, &levels)?,
             pipelines,
             ruler,
-            sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, rotation, intensity)?,
+            sh_buffers: ShBuffers::new(ctx, &inputs.lighting_env, rotation, factor)?,
             inputs,
             lighting,
             weights: weights.try_into().unwrap_or([Vec3::ZERO; 6]),
@@ -480,7 +480,7 @@ impl Frame {
         let env = &scene.file.environment;
         self.lighting.turn(env.rotation_deg);
         self.sh_buffers
-            .set_transform(ctx, env.rotation_deg, env.intensity)?;
+            .set_transform(ctx, env.rotation_deg, self.lighting.env_factor())?;
         self.passes.shadow.set_tiles(&self.lighting.tiles());
         self.set_camera(ctx, scene)
     }
@@ -496,6 +496,12 @@ impl Frame {
     pub(super) fn encode(&self, g: &mut Graph, image: ImageHandle, view: &View) -> ImageHandle {
         let images = self.post(g, view.shown(), image);
         images.ldr.expect("post makes the 8-bit image")
+    }
+
+    /// log2 P: the EV the frame's HDR targets are exposed by already
+    /// (scene::range); their values are the light × 2^this.
+    pub(super) fn pre_ev(&self) -> f32 {
+        self.lighting.pre_exposure.ev()
     }
 
     /// The exposure and display of a view shown as `shown`.
@@ -686,6 +692,11 @@ impl Frame {
         let hdr = match self.post.glow {
             Some(intensity) if shown == Shown::Exposed => p.glow.pass(g, &hdr, intensity),
             _ => hdr,
+        };
+        // A given exposure applies to the light before its pre-exposure.
+        let exposure = match exposure {
+            Exposure::Given(ev) if shown == Shown::Exposed => Exposure::Given(ev - self.pre_ev()),
+            e => e,
         };
         let (w, h) = (hdr.desc.width, hdr.desc.height);
         let mut ldr = g.create_image("ldr", ImageDesc::new(w, h, LDR_FORMAT));

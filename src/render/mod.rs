@@ -492,12 +492,25 @@ fn run(
         None => None,
     };
     let (exposure, display) = frame.display(view.shown());
+    // Metered on the pre-exposed values (as the GPU's meter is), then read as
+    // the scene's light: the values ÷ P, the EV + log2 P.
+    let pre_ev = match view.shown() {
+        Shown::Exposed => frame.pre_ev(),
+        _ => 0.0,
+    };
     let metered = match (exposure, &hdr) {
         _ if gpu_metered => Some(Metered::from_bytes(exposure_readback.bytes()?)),
         // UV-space views are metered here, on the CPU.
         (Exposure::Metered, Some(values)) if uv => Some(meter::exposure(values)),
         _ => None,
-    };
+    }
+    .map(|m| m.pre_exposed_by(pre_ev));
+    if let Some(values) = &mut hdr {
+        let scale = (-pre_ev).exp2();
+        for p in values.chunks_exact_mut(4) {
+            p[..3].iter_mut().for_each(|c| *c *= scale);
+        }
+    }
     let ev = match (exposure, metered) {
         (Exposure::Given(ev), _) => ev,
         (Exposure::Metered, m) => m.map_or(0.0, |m| m.ev),

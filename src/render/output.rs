@@ -40,14 +40,18 @@ pub fn write(path: &Path, out: &RenderOutput) -> Result<()> {
             let hdr = out.hdr.as_ref().ok_or_else(|| {
                 Error::Input(format!("{}: no HDR image was rendered", path.display()))
             })?;
+            // In f64: 2^exposure alone may overflow f32 where the light is faint.
             let scale = if out.view.uv_space() {
                 1.0
             } else {
-                out.exposure.exp2()
+                f64::from(out.exposure).exp2()
             };
             let exposed: Vec<f32> = hdr
                 .chunks_exact(4)
-                .flat_map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
+                .flat_map(|p| {
+                    let e = |c: f32| (f64::from(c) * scale) as f32;
+                    [e(p[0]), e(p[1]), e(p[2]), p[3]]
+                })
                 .collect();
             write_exr(path, w, h, &exposed)
         }

@@ -85,6 +85,8 @@ pub struct Scene {
     pub env: EnvMap,
     pub camera: Camera,
     pub lights: Vec<Light>,
+    /// The powers of two its light is rendered at (range::PreExposure).
+    pub pre_exposure: range::PreExposure,
     /// The settings it was loaded from (skin, render, environment rotation and intensity).
     pub file: SceneFile,
 }
@@ -182,7 +184,8 @@ impl Scene {
                 angular_radius: 0.5 * l.angular_diameter_deg.to_radians(),
             })
             .collect::<Vec<_>>();
-        range::check(&file, &env, &lights, &mesh).map_err(crate::Error::Input)?;
+        let pre_exposure =
+            range::pre_exposure(&file, &env, &lights, &mesh).map_err(crate::Error::Input)?;
         Ok(Scene {
             mesh,
             albedo,
@@ -193,6 +196,7 @@ impl Scene {
             env,
             camera,
             lights,
+            pre_exposure,
             file,
         })
     }

@@ -1,14 +1,18 @@
-//! What the half-float (RGBA16F) targets can hold: a scene whose lighting would
-//! overflow them renders a wrong image, so it is refused at load, naming the
-//! largest intensity that works.
+//! Pre-exposure: the lighting scaled by a power of two before it reaches the
+//! half-float (RGBA16F) targets, so that any finite intensity renders right
+//! (the pre-exposed lights of Filament's PBR notes and of Lagarde & de
+//! Rousiers 2014, "Moving Frostbite to PBR").
 //!
 //! The bound: the irradiance any surface can receive is at most the map's
 //! largest cosine-weighted irradiance over all normals, × `environment.intensity`,
-//! plus every light's irradiance (a point light's at its nearest vertex). The
-//! targets hold about that irradiance at most, so it × [`SHADING_HEADROOM`]
-//! must stay within [`HALF_MAX`]. The skybox shows the map's radiance ×
-//! intensity as it is: texels beyond [`HALF_MAX`] (the built-in sky's sun)
-//! saturate there, as a sun should; `-v` logs it.
+//! plus every light's irradiance (a point light's at its nearest vertex). Where
+//! that bound lies within [[`LOW`], [`HIGH`]] the targets hold the light as it
+//! is (P = 1: every such scene renders as before); elsewhere every light, the
+//! environment and the skybox are × P = 2^k, the power of two that brings the
+//! bound nearest [`TARGET`], and the results are read back ÷ P and the exposure
+//! applied as EV − k, all exact in binary floating point. The map's own texels
+//! get the same rule (its prefiltered copy is half float too): they are
+//! uploaded × M and the environment's factor on the GPU is intensity·P/M.
 
 use super::env::{texel_solid_angle_f64, EnvMap, HALF_MAX};
 use super::file::SceneFile;
@@ -20,6 +24,19 @@ use super::{Light, LightSource, POINT_LIGHT_REFERENCE_MM};
 /// radiance E/π × albedo plus the specular term, whose KS lobe can rise above
 /// E/π at grazing angles; 2 leaves room for it.
 pub const SHADING_HEADROOM: f64 = 2.0;
+/// The largest irradiance bound the targets hold as it is: [`HALF_MAX`] /
+/// [`SHADING_HEADROOM`].
+pub const HIGH: f64 = HALF_MAX as f64 / SHADING_HEADROOM;
+/// The smallest: at 1/16 a pixel 2^-10 of the brightest still has a normal half
+/// float (≥ 2^-14), so the 8-bit image keeps its levels.
+pub const LOW: f64 = 1.0 / 16.0;
+/// Where a pre-exposed bound lands: 16, 2^4 above [`LOW`] and 2^11 below [`HIGH`]
+/// (dark pixels matter more than the specular's headroom).
+pub const TARGET: f64 = 16.0;
+/// The largest |exposure − log2 P| in EV: the targets' values × 2^±100 stay
+/// finite and non-zero in f32 (65504 × 2^100 ≈ 8.3e34 < 3.4e38; 2^-24 × 2^-100
+/// = 2^-124 is still a normal f32).
+pub const MAX_EXPOSURE_EV: f32 = 100.0;
 
 /// Cells of the grid the map is binned into for [`env_peaks`], and normals tried.
 const GRID: (usize, usize) = (64, 32);
@@ -27,6 +44,38 @@ const NORMALS: usize = 1024;
 /// For normals between those tried (≤ 3.5° from one: cos ≥ 0.998) and texels
 /// within half a cell (≤ 2.9°) of their cell's centre.
 const MARGIN: f64 = 1.01;
+
+/// The scales a scene's light is rendered at (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreExposure {
+    /// P: the lights and the environment × P on the GPU, read back ÷ P.
+    pub lighting: f32,
+    /// M: the map's texels × M when uploaded.
+    pub map: f32,
+}
+
+impl PreExposure {
+    /// Light as it is.
+    pub const NONE: PreExposure = PreExposure {
+        lighting: 1.0,
+        map: 1.0,
+    };
+
+    /// log2 P: the EV the targets are exposed by already.
+    pub fn ev(&self) -> f32 {
+        self.lighting.log2()
+    }
+}
+
+/// 1 when `bound` lies within [LOW, HIGH] (or is 0), else the power of two that
+/// brings it nearest TARGET; `None` when that is not a normal f32.
+fn power_of_two_for(bound: f64) -> Option<f32> {
+    if bound == 0.0 || (LOW..=HIGH).contains(&bound) {
+        return Some(1.0);
+    }
+    let k = (TARGET / bound).log2().round();
+    (k.abs() <= 126.0).then(|| (k as f32).exp2())
+}
 
 /// The map's brightest channel value, and the largest irradiance (channel) it
 /// gives any surface, before `environment.intensity`: the largest over normals
@@ -91,58 +140,66 @@ fn light_peak(light: &Light, mesh: &Mesh) -> f64 {
     f64::from(light.irradiance.max_element()) * scale
 }
 
-/// Refuses a scene whose lighting may overflow the half-float targets (module
-/// doc); logs (info) when the skybox's brightest texel would.
-pub fn check(file: &SceneFile, env: &EnvMap, lights: &[Light], mesh: &Mesh) -> Result<(), String> {
-    let budget = f64::from(HALF_MAX) / SHADING_HEADROOM;
+/// The pre-exposure of a scene (module doc). Refuses, naming the key, only a
+/// scene whose light no normal f32 power of two brings into range, or an
+/// exposure beyond [`MAX_EXPOSURE_EV`] of it; logs (info) when the skybox's
+/// brightest texel saturates.
+pub fn pre_exposure(
+    file: &SceneFile,
+    env: &EnvMap,
+    lights: &[Light],
+    mesh: &Mesh,
+) -> Result<PreExposure, String> {
     let intensity = f64::from(file.environment.intensity);
     let (peak, env_irradiance) = env_peaks(env);
-    let per_light: Vec<f64> = lights.iter().map(|l| light_peak(l, mesh)).collect();
-    let from_lights: f64 = per_light.iter().sum();
-    let total = intensity * env_irradiance + from_lights;
-    if file.render.skybox && intensity * peak > f64::from(HALF_MAX) {
+    let total =
+        intensity * env_irradiance + lights.iter().map(|l| light_peak(l, mesh)).sum::<f64>();
+    let fmt = |v: f64| format!("{v:.4e}");
+    let lighting = power_of_two_for(total).ok_or_else(|| {
+        format!(
+            "the lighting reaches an irradiance of {} on the mesh (environment {} × \
+             environment.intensity = {intensity}, and the lights): no power of two within \
+             2^±126 brings it into what half floats hold",
+            fmt(total),
+            file.environment.source
+        )
+    })?;
+    let map = power_of_two_for(env_irradiance).ok_or_else(|| {
+        format!(
+            "environment {}: its irradiance {} is beyond what half floats hold by more than 2^±126",
+            file.environment.source,
+            fmt(env_irradiance)
+        )
+    })?;
+    let p = PreExposure { lighting, map };
+    if file.render.skybox && intensity * peak * f64::from(lighting) > f64::from(HALF_MAX) {
         log::info!(
             "environment: its brightest texel ({peak:.4e}) × environment.intensity ({intensity}) \
-             exceeds half-float's {HALF_MAX}: the skybox saturates there"
+             × pre-exposure {lighting} exceeds half-float's {HALF_MAX}: the skybox saturates there"
         );
     }
-    if total <= budget && total.is_finite() {
-        return Ok(());
+    if lighting != 1.0 || map != 1.0 {
+        log::info!(
+            "pre-exposure: the lighting's bound {} × {lighting} (2^{}), the map × {map}",
+            fmt(total),
+            p.ev()
+        );
     }
-    let fmt = |v: f64| format!("{:.4e}", v.max(0.0));
-    let largest = if intensity * env_irradiance >= from_lights {
-        let rest = budget - from_lights;
-        format!(
-            "environment {} is too bright: its radiance reaches {} and gives at most {} of \
-             irradiance, × environment.intensity = {intensity}; at most environment.intensity \
-             = {} works with it (or a source {}× as bright)",
-            file.environment.source,
-            fmt(peak),
-            fmt(env_irradiance),
-            fmt(rest / env_irradiance),
-            match rest / (intensity * env_irradiance) {
-                r if r >= 1e-3 => format!("{r:.3}"),
-                r => format!("{:.3e}", r.max(0.0)),
-            }
-        )
-    } else {
-        let (i, own) =
-            per_light
-                .iter()
-                .enumerate()
-                .fold((0, 0.0), |a, (i, &v)| if v > a.1 { (i, v) } else { a });
-        let rest = budget - (total - own);
-        let intensity = f64::from(file.lights[i].intensity);
-        format!(
-            "lights[{i}].intensity = {intensity}: at most {} works",
-            fmt(intensity * rest / own)
-        )
-    };
-    Err(format!(
-        "{largest}; the lighting would reach an irradiance of {} on the mesh, beyond \
-         {HALF_MAX} (half-float targets) / {SHADING_HEADROOM} (headroom for the specular term)",
-        fmt(total)
-    ))
+    if let Some(e) = file.render.exposure {
+        let applied = e - p.ev();
+        if applied.abs() > MAX_EXPOSURE_EV {
+            return Err(format!(
+                "render.exposure = {e}: must be in {}..={} EV for this scene's light (an \
+                 irradiance of {}, pre-exposed by 2^{}); beyond, what the half-float targets \
+                 hold becomes inf or 0 in 32-bit floats",
+                p.ev() - MAX_EXPOSURE_EV,
+                p.ev() + MAX_EXPOSURE_EV,
+                fmt(total),
+                p.ev()
+            ));
+        }
+    }
+    Ok(p)
 }
 
 #[cfg(test)]
@@ -168,50 +225,85 @@ mod tests {
         }
     }
 
+    fn file_with_a_sun() -> SceneFile {
+        SceneFile {
+            lights: vec![toml::from_str("kind = \"directional\"\ndirection = [0, -1, 0]").unwrap()],
+            ..SceneFile::default()
+        }
+    }
+
     #[test]
-    fn intensities_beyond_half_float_are_refused_naming_what_works() {
+    fn light_within_what_half_floats_hold_is_not_pre_exposed() {
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X],
+            ..Mesh::default()
+        };
+        let mut file = file_with_a_sun();
+        let sun = [light(LightSource::Directional(Vec3::Y), 1.0)];
+        for (map, intensity) in [(1.0, 1.0), (1.0, 0.02), (1e3, 10.0)] {
+            file.environment.intensity = intensity;
+            let env = EnvMap::uniform(Vec3::splat(map), 64, 32);
+            assert_eq!(
+                pre_exposure(&file, &env, &sun, &mesh),
+                Ok(PreExposure::NONE),
+                "{map} × {intensity}"
+            );
+        }
+    }
+
+    #[test]
+    fn light_beyond_it_is_brought_to_the_target_by_a_power_of_two() {
         let mesh = Mesh {
             positions: vec![Vec3::ZERO, Vec3::X],
             ..Mesh::default()
         };
         let env = EnvMap::uniform(Vec3::ONE, 64, 32);
-        let mut file = SceneFile {
-            lights: vec![toml::from_str("kind = \"directional\"\ndirection = [0, -1, 0]").unwrap()],
-            ..SceneFile::default()
-        };
-        let sun = [light(LightSource::Directional(Vec3::Y), 1.0)];
-        assert!(check(&file, &env, &sun, &mesh).is_ok());
-
-        // (π × 1.01 × intensity + 1) × 2 > 65504 from intensity ≈ 1.032e4.
-        file.environment.intensity = 3e4;
-        let e = check(&file, &env, &sun, &mesh).unwrap_err();
-        assert!(
-            e.starts_with("environment sky:")
-                && e.contains("is too bright")
-                && e.contains("or a source 0.344× as bright")
-                && e.contains("environment.intensity = 30000")
-                && e.contains("at most environment.intensity = 1.03"),
-            "{e}"
-        );
+        let mut file = file_with_a_sun();
+        let sun = |e: f32| [light(LightSource::Directional(Vec3::Y), e)];
+        // The bound is π·1.01·intensity + the sun's irradiance.
+        let bound = |i: f64, s: f64| std::f64::consts::PI * MARGIN * i + s;
+        for (intensity, s) in [
+            (3e4, 1.0),
+            (1e-30, 0.0),
+            (1e30, 0.0),
+            (1e-6, 0.0),
+            (1.0, 1e6),
+        ] {
+            file.environment.intensity = intensity as f32;
+            let p = pre_exposure(&file, &env, &sun(s as f32), &mesh).unwrap();
+            let k = p.ev();
+            assert_eq!(k, k.round(), "{intensity}: P = 2^{k}");
+            let pre = bound(f64::from(intensity as f32), s) * f64::from(p.lighting);
+            assert!(
+                pre > TARGET / 2f64.sqrt() && pre < TARGET * 2f64.sqrt(),
+                "{intensity}, {s}: {pre} against {TARGET}"
+            );
+            assert_eq!(p.map, 1.0);
+        }
+        // The map's own scale: uniform:1e5 is uploaded × 2^-14.
+        let bright = EnvMap::uniform(Vec3::splat(1e5), 64, 32);
         file.environment.intensity = 1.0;
+        let p = pre_exposure(&file, &bright, &[], &mesh).unwrap();
+        assert_eq!((p.map, p.lighting), (2f32.powi(-14), 2f32.powi(-14)));
+    }
 
-        file.lights[0].intensity = 1e6;
-        let e = check(
-            &file,
-            &env,
-            &[light(LightSource::Directional(Vec3::Y), 1e6)],
-            &mesh,
-        )
-        .unwrap_err();
+    #[test]
+    fn an_exposure_beyond_floats_of_the_pre_exposed_light_is_refused() {
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO],
+            ..Mesh::default()
+        };
+        let env = EnvMap::uniform(Vec3::ONE, 64, 32);
+        let mut file = SceneFile::default();
+        file.render.exposure = Some(150.0);
+        let e = pre_exposure(&file, &env, &[], &mesh).unwrap_err();
         assert!(
-            e.starts_with("lights[0].intensity = 1000000") && e.contains("at most 3.27"),
+            e.starts_with("render.exposure = 150: must be in -100..=100 EV"),
             "{e}"
         );
-
-        // A point light 10 mm from the mesh delivers 10⁴ × its intensity.
-        file.lights[0].intensity = 10.0;
-        let near = [light(LightSource::Point(Vec3::new(0.0, 10.0, 0.0)), 10.0)];
-        let e = check(&file, &env, &near, &mesh).unwrap_err();
-        assert!(e.starts_with("lights[0].intensity = 10:"), "{e}");
+        // At 1e-30 the light is pre-exposed by 2^102, and 150 EV is within 100 of it.
+        file.environment.intensity = 1e-30;
+        let p = pre_exposure(&file, &env, &[], &mesh).unwrap();
+        assert_eq!(p.ev(), 102.0);
     }
 }

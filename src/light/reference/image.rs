@@ -273,6 +273,7 @@ mod tests {
                 far_mm: 5000.0,
             },
             lights: Vec::new(),
+            pre_exposure: crate::scene::range::PreExposure::NONE,
             file,
         }
     }

@@ -138,11 +138,6 @@ impl Default for Render {
 /// Largest accepted render width or height.
 pub const MAX_RENDER_SIZE: u32 = 16384;
 
-/// The largest |exposure| in EV: the targets' values × 2^±100 stay finite and
-/// non-zero in f32 (65504 × 2^100 ≈ 8.3e34 < 3.4e38; 2^-24 × 2^-100 = 2^-124
-/// is still a normal f32).
-pub const MAX_EXPOSURE_EV: f32 = 100.0;
-
 impl Render {
     pub(super) fn validate(&self) -> Result<(), String> {
         for (key, v) in [("render.width", self.width), ("render.height", self.height)] {
@@ -159,14 +154,8 @@ impl Render {
             }
         }
         if let Some(e) = self.exposure {
+            // Its range depends on the scene's light (scene::range).
             finite("render.exposure", e)?;
-            if e.abs() > MAX_EXPOSURE_EV {
-                return Err(format!(
-                    "render.exposure = {e}: must be in -{MAX_EXPOSURE_EV}..={MAX_EXPOSURE_EV} EV \
-                     (beyond, what the half-float targets hold, 2^-24..65504, becomes inf or 0 \
-                     in 32-bit floats: an EXR of inf/NaN or zeros, a PNG all white or black)"
-                ));
-            }
         }
         if let Gamma::Power(g) = self.gamma {
             finite("render.gamma", g)?;
