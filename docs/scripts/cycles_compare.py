@@ -122,11 +122,22 @@ def read_dermis(path):
 
 def read_cycles(path):
     ch = OpenEXR.File(path).parts[0].channels
+    if "Combined" in ch:
+        # docs/scripts/mitsuba_medium.py: positions in dermis world mm already.
+        return ch["Combined"].pixels.astype(np.float64), ch["Position"].pixels.astype(np.float64)
     rgba = ch["ViewLayer.Combined"].pixels.astype(np.float64)
     pos = np.stack([ch[f"ViewLayer.Position.{c}"].pixels for c in "XYZ"], -1)
     # Blender (units, Z up) to dermis (mm, Y up): (x, y, z) -> (x, z, -y).
     mm = np.stack([pos[..., 0], pos[..., 2], -pos[..., 1]], -1) * MM_PER_UNIT
     return rgba, mm.astype(np.float64)
+
+
+def binned(image, k):
+    """The mean over k x k blocks of pixels (a partial block at the edges is dropped)."""
+    if k == 1:
+        return image
+    h, w = image.shape[0] // k * k, image.shape[1] // k * k
+    return image[:h, :w].reshape(h // k, k, w // k, k, -1).mean((1, 3))
 
 
 def luminance(rgb):
@@ -208,6 +219,13 @@ def main():
         "--env uniform:0,0,0): its black pixels, where no light reaches directly, "
         "form the groups 'unlit' and 'REGION unlit'",
     )
+    p.add_argument(
+        "--bins",
+        type=int,
+        default=1,
+        help="compare means over BINS x BINS of dermis's pixels (a reference rendered at "
+        "1/S of dermis's size is binned by BINS/S); a bin counts where both cover it whole",
+    )
     args = p.parse_args()
     for f in [args.dermis] + args.cycles + ([args.unlit] if args.unlit else []):
         if not os.path.isfile(f):
@@ -218,6 +236,18 @@ def main():
 
     dermis = read_dermis(args.dermis)
     refs = [read_cycles(f) for f in args.cycles]
+    scale = dermis.shape[0] // refs[0][0].shape[0]
+    if args.bins % scale or dermis.shape[0] != scale * refs[0][0].shape[0]:
+        p.error(f"dermis {dermis.shape[:2]} is not {args.bins}-binnable onto the reference "
+                f"{refs[0][0].shape[:2]}")
+    if args.bins > 1:
+        # Coverage as the fraction of a bin covered (dermis's alpha > 0.5 per pixel).
+        dermis[..., 3] = dermis[..., 3] > 0.5
+        dermis = binned(dermis, args.bins)
+        k = args.bins // scale
+        refs = [(binned(rgba, k), binned(pos * rgba[..., 3:], k) / np.maximum(binned(rgba[..., 3:], k), 1e-9))
+                for rgba, pos in refs]
+        dermis[..., 3] = np.where(dermis[..., 3] > 0.999, 1.0, 0.0)
     for rgba, _ in refs:
         if rgba.shape != dermis.shape:
             p.error(f"sizes differ: dermis {dermis.shape[:2]}, Cycles {rgba.shape[:2]}")

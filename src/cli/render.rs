@@ -245,7 +245,7 @@ pub fn precompute(args: PrecomputeArgs, context: &ContextOptions) -> dermis::Res
         mesh,
         &t,
         skin.occlusion,
-        &settings.profile,
+        &settings.falloff(),
         settings.transmission,
     );
     outln!(

@@ -23,6 +23,9 @@
 //! ```
 //! times `skin.transmission`, so that `M = Σ_j L_j X_j`. On a slab d thick
 //! this is `E·Σ wᵢ exp(−d²/2vᵢ)` ([`Profile::transmittance`], the tests).
+//! With a medium, R is the kernel whose integral over a slab's far side is
+//! the medium's walked T(d) ÷ albedo (the final pass multiplies by the
+//! albedo): ∫_d^∞ R(r) 2πr dr = T(d) gives R(r) = −T′(r)/2πr (skin::falloff).
 //! The GPU applies it to the environment's SH only (the explicit lights have
 //! their own term).
 
@@ -33,16 +36,7 @@ use super::occlusion::{cache_key, directions, rgb_cached, transfer_key};
 use super::occlusion::{Bvh, RayOptions, RgbTransfer, Transfer};
 use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;
-use crate::skin::profile::Profile;
-
-/// The profile's reach: at 4σ of its widest Gaussian exp(−d²/2v) = e⁻⁸ ≈ 3·10⁻⁴.
-fn reach_mm(profile: &Profile) -> f32 {
-    4.0 * profile
-        .gaussians
-        .last()
-        .map_or(0.0, |g| g.variance_mm2)
-        .sqrt()
-}
+use crate::skin::falloff::Falloff;
 
 /// Far sides met at grazing angles count as if met at this cosine (the
 /// estimator's 1/cos_q would let one ray dominate).
@@ -54,7 +48,7 @@ fn vertex(
     bvh: &Bvh,
     mesh: &Mesh,
     direct: &Transfer,
-    profile: &Profile,
+    falloff: &Falloff,
     p: Vec3,
     nrm: Vec3,
     opts: &RayOptions,
@@ -65,7 +59,7 @@ fn vertex(
     let origin = p - nrm * offset;
     let mut out = [[0.0f64; 9]; 3];
     for w in directions(-nrm, n, opts.seed, i) {
-        let Some(hit) = bvh.closest_hit(origin, w, reach_mm(profile)) else {
+        let Some(hit) = bvh.closest_hit(origin, w, falloff.reach_mm()) else {
             continue;
         };
         let Some(normal) = hit.interpolate(mesh, &mesh.normals).try_normalize() else {
@@ -79,7 +73,7 @@ fn vertex(
         // R at the distance from p; the area element from the ray's origin,
         // where the directions are drawn.
         let r = (origin + w * hit.t - p).length();
-        let weight = profile.radial(r) * hit.t * hit.t / (cos_q.max(MIN_COS_Q) * w.dot(-nrm));
+        let weight = falloff.radial(r) * hit.t * hit.t / (cos_q.max(MIN_COS_Q) * w.dot(-nrm));
         let (corners, b) = (hit.corners(mesh), hit.barycentric.to_array());
         for (c, row) in out.iter_mut().enumerate() {
             for (j, x) in row.iter_mut().enumerate() {
@@ -92,18 +86,18 @@ fn vertex(
     out.map(|row| row.map(|x| (x * scale) as f32))
 }
 
-/// The transmitted transfer of `mesh` through `profile` under its direct
+/// The transmitted transfer of `mesh` through `falloff` under its direct
 /// transfer `direct`, scaled by `scale` (`skin.transmission`; 0: none), by
 /// rays cast as `opts` says.
 pub fn transmitted(
     mesh: &Mesh,
     direct: &Transfer,
-    profile: &Profile,
+    falloff: &Falloff,
     scale: f32,
     opts: &RayOptions,
 ) -> RgbTransfer {
     let count = mesh.vertex_count();
-    if scale <= 0.0 || reach_mm(profile) <= 0.0 {
+    if scale <= 0.0 || falloff.reach_mm() <= 0.0 {
         return RgbTransfer::none(count);
     }
     let start = std::time::Instant::now();
@@ -114,7 +108,7 @@ pub fn transmitted(
             let p = mesh.positions[i];
             match mesh.normals.get(i).and_then(|n| n.try_normalize()) {
                 Some(n) if p.is_finite() => {
-                    vertex(&bvh, mesh, direct, profile, p, n, opts, i as u32)
+                    vertex(&bvh, mesh, direct, falloff, p, n, opts, i as u32)
                         .map(|row| row.map(|x| x * scale))
                 }
                 _ => [[0.0; 9]; 3],
@@ -124,7 +118,7 @@ pub fn transmitted(
     log::info!(
         "transmission: {count} vertices × {} rays within {:.1} mm: {:.2} s",
         opts.samples,
-        reach_mm(profile),
+        falloff.reach_mm(),
         start.elapsed().as_secs_f64()
     );
     RgbTransfer { coeffs }
@@ -132,13 +126,13 @@ pub fn transmitted(
 
 /// [`transmitted`] with the default rays under the direct transfer `direct` of
 /// occlusion `mode` (none for `Off`), from the disk cache when it holds it
-/// (keyed by the mesh, the direct transfer's key, the profile, the scale and
+/// (keyed by the mesh, the direct transfer's key, the falloff, the scale and
 /// the settings).
 pub fn transmitted_for(
     mesh: &Mesh,
     direct: &Transfer,
     mode: Occlusion,
-    profile: &Profile,
+    falloff: &Falloff,
     scale: f32,
 ) -> RgbTransfer {
     let Some(direct_key) = transfer_key(mesh, mode).filter(|_| scale > 0.0) else {
@@ -148,29 +142,15 @@ pub fn transmitted_for(
         seed: 2,
         ..RayOptions::default()
     };
-    let gaussians: Vec<String> = profile
-        .gaussians
-        .iter()
-        .map(|g| {
-            let w = g.weights.to_array().map(f32::to_bits);
-            format!(
-                "{:08x}:{:08x}{:08x}{:08x}",
-                g.variance_mm2.to_bits(),
-                w[0],
-                w[1],
-                w[2]
-            )
-        })
-        .collect();
     let settings = format!(
         "{} direct={direct_key} scale={:08x} profile={}",
         opts.cache_settings(),
         scale.to_bits(),
-        gaussians.join(",")
+        falloff.key()
     );
     let key = cache_key(mesh, "transmission", &settings);
     rgb_cached("transmission", &key, mesh.vertex_count(), || {
-        transmitted(mesh, direct, profile, scale, &opts)
+        transmitted(mesh, direct, falloff, scale, &opts)
     })
 }
 
@@ -180,6 +160,7 @@ mod tests {
     use crate::light::occlusion::testutil::mesh;
     use crate::light::occlusion::{raytrace, unoccluded};
     use crate::light::sh;
+    use crate::skin::profile::Profile;
 
     /// A slab d mm thick, 2 m across: the front face (normal +Z) a fan around
     /// vertex 0 at the origin, the back face (normal −Z) at z = −d.
@@ -210,7 +191,13 @@ mod tests {
         let profile = Profile::skin();
         for d in [0.5_f32, 1.0, 2.0, 3.5, 5.0] {
             let m = slab(d);
-            let x = transmitted(&m, &unoccluded(&m), &profile, 1.0, &RayOptions::default());
+            let x = transmitted(
+                &m,
+                &unoccluded(&m),
+                &Falloff::Profile(&profile),
+                1.0,
+                &RayOptions::default(),
+            );
             let (e, expected) = (transmitted_share(&x), profile.transmittance(d));
             eprintln!("d {d} mm: E/πL {e:.5}, T(d) {expected:.5}");
             for c in 0..3 {
@@ -223,9 +210,56 @@ mod tests {
         }
         // Scaled by skin.transmission; none at 0.
         let m = slab(1.0);
-        let at = |scale| transmitted(&m, &unoccluded(&m), &profile, scale, &RayOptions::default());
+        let at = |scale| {
+            transmitted(
+                &m,
+                &unoccluded(&m),
+                &Falloff::Profile(&profile),
+                scale,
+                &RayOptions::default(),
+            )
+        };
         assert_eq!(at(0.5).coeffs[0][0][0] * 2.0, at(1.0).coeffs[0][0][0]);
         assert_eq!(at(0.0), RgbTransfer::none(9));
+    }
+
+    /// With a medium's slab table the far side's light integrates back to
+    /// the table: T(d) where it falls, and its largest value beyond d where a
+    /// thin slab's scattered light still rises (the envelope), within 2 %
+    /// from 1 mm (thinner, [`MIN_COS_Q`] drops part of the light arriving
+    /// from beyond 10 d: −16 % at 0.3 mm for this table).
+    #[test]
+    fn a_backlit_slab_transmits_a_medium_s_table() {
+        let max_mm = 12.0;
+        let n = 48;
+        let d_of = |i: usize| max_mm * (i as f32 / (n - 1) as f32).powi(2);
+        // Rises to a peak at 1 mm, then falls as e^(−d/1.5), per channel slower.
+        let t = |d: f32| Vec3::new(0.3, 0.2, 0.1) * (d / (d + 0.1)) * (-(d / 1.5).max(0.6)).exp();
+        let samples: Vec<Vec3> = (0..n).map(|i| t(d_of(i))).collect();
+        let falloff = Falloff::slab(&samples, max_mm);
+        let envelope = |d: f32| {
+            (0..n)
+                .filter(|&i| d_of(i) >= d)
+                .fold(Vec3::ZERO, |a, i| a.max(samples[i]))
+        };
+        for d in [1.0_f32, 2.0, 3.5, 5.0] {
+            let m = slab(d);
+            let x = transmitted(&m, &unoccluded(&m), &falloff, 1.0, &RayOptions::default());
+            let e = transmitted_share(&x);
+            // The table read linearly in √d, as the kernel integrates it.
+            let s = (d / max_mm).sqrt() * (n - 1) as f32;
+            let (i, f) = (s as usize, s.fract());
+            let want = envelope(d_of(i)).lerp(envelope(d_of(i + 1)), f);
+            eprintln!("d {d} mm: E/πL {e:.5}, T {want:.5}");
+            for c in 0..3 {
+                assert!(
+                    (e[c] - want[c]).abs() <= 0.02 * want[c] + 1e-5,
+                    "d {d} mm, channel {c}: {} against {}",
+                    e[c],
+                    want[c]
+                );
+            }
+        }
     }
 
     /// Nothing comes through a block thicker than the profile's reach, nor
@@ -237,12 +271,18 @@ mod tests {
         let profile = Profile::skin();
         let opts = RayOptions::default();
         let m = slab(30.0);
-        let x = transmitted(&m, &unoccluded(&m), &profile, 1.0, &opts);
+        let x = transmitted(&m, &unoccluded(&m), &Falloff::Profile(&profile), 1.0, &opts);
         assert_eq!(transmitted_share(&x), Vec3::ZERO);
         // A second slab 5 mm behind the first one's far side, ten times as
         // wide (so that the far side's corners see no sky either), covers it.
         let mut m = slab(1.0);
-        let open = transmitted_share(&transmitted(&m, &unoccluded(&m), &profile, 1.0, &opts));
+        let open = transmitted_share(&transmitted(
+            &m,
+            &unoccluded(&m),
+            &Falloff::Profile(&profile),
+            1.0,
+            &opts,
+        ));
         let base = m.positions.len() as u32;
         for k in 5..9 {
             let p = m.positions[k];
@@ -257,7 +297,7 @@ mod tests {
         let covered = transmitted_share(&transmitted(
             &m,
             &raytrace(&m, &opts, false),
-            &profile,
+            &Falloff::Profile(&profile),
             1.0,
             &opts,
         ));
@@ -265,7 +305,13 @@ mod tests {
         assert!(covered.x < 0.02 * open.x, "{covered} against {open}");
         // A sphere of radius 20 mm seen from outside.
         let sphere = crate::light::occlusion::testutil::open_sphere(20.0, 0.0, 24, 48);
-        let x = transmitted(&sphere, &unoccluded(&sphere), &profile, 1.0, &opts);
+        let x = transmitted(
+            &sphere,
+            &unoccluded(&sphere),
+            &Falloff::Profile(&profile),
+            1.0,
+            &opts,
+        );
         assert!(x.coeffs.iter().flatten().flatten().all(|&c| c == 0.0));
     }
 }

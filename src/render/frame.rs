@@ -181,7 +181,7 @@ fn frame_inputs(
         &scene.mesh,
         &transfer,
         occlusion,
-        &skin.profile,
+        &skin.falloff(),
         skin.transmission,
     );
     // Per vertex: the interreflected transfer, then the transmitted one.

@@ -146,6 +146,17 @@ impl MediumTables {
         profile_of(&self.reference_gaussians)
     }
 
+    /// T(d) ÷ albedo at the samples: what the final pass's transmitted light
+    /// is multiplied by the albedo after (the medium's own, or the map's
+    /// colour on the medium's shape).
+    pub fn transmittance_over_albedo(&self) -> Vec<Vec3> {
+        let albedo = Vec3::from(self.albedo).max(Vec3::splat(1e-6));
+        self.transmittance
+            .iter()
+            .map(|&t| Vec3::from(t) / albedo)
+            .collect()
+    }
+
     /// T(d), linear between the samples (in √d, as translucent.frag reads
     /// them), 0 past the last.
     pub fn transmittance_at(&self, d_mm: f32) -> Vec3 {

@@ -4,6 +4,7 @@
 
 pub mod blur;
 pub mod chain;
+pub mod falloff;
 pub mod fit;
 pub mod irradiance;
 pub mod medium;
@@ -28,6 +29,7 @@ use crate::scene::texture::{Encoding, Texture};
 use crate::scene::Scene;
 use ash::vk;
 use blur::BlurKernel;
+use falloff::Falloff;
 use glam::Vec3;
 use medium::Medium;
 use medium_tables::MediumTables;
@@ -92,6 +94,18 @@ pub struct MediumSkin {
 }
 
 impl SkinSettings {
+    /// What light through thin skin falls off by: the medium's slab
+    /// transmission, else the profile (light::transmission).
+    pub fn falloff(&self) -> Falloff<'_> {
+        match &self.medium {
+            Some(m) => Falloff::slab(
+                &m.tables.transmittance_over_albedo(),
+                m.tables.max_thickness_mm,
+            ),
+            None => Falloff::Profile(&self.profile),
+        }
+    }
+
     pub fn resolve(skin: &Skin, render: &Render) -> Result<Self> {
         let medium = medium_skin(skin);
         let profile = match (&medium, &skin.profile) {

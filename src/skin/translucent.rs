@@ -71,16 +71,11 @@ impl TranslucentPass {
             | vk::ImageUsageFlags::TRANSFER_SRC;
         let desc = ImageDesc::new(side, side, UV_FORMAT);
         let image = |name| Image::new(ctx, name, desc, usage).map(Arc::new);
-        // T(d)/albedo: the final pass multiplies the transmitted light by the
-        // albedo (the medium's own, or the map's colour on the medium's shape).
         let texels: Vec<[f32; 4]> = match medium {
             Some(t) => t
-                .transmittance
+                .transmittance_over_albedo()
                 .iter()
-                .map(|v| {
-                    let per = |c: usize| v[c] / t.albedo[c].max(1e-6);
-                    [per(0), per(1), per(2), 1.0]
-                })
+                .map(|v| v.extend(1.0).to_array())
                 .collect(),
             None => vec![[0.0; 4]],
         };
