@@ -21,8 +21,8 @@
 # Knobs (environment, or edit here): DERMIS (binary), OUT (shared folder),
 # SHARDS (tasks; every submission of one sweep must use the same), CPUS (cores
 # per task; default: 8, or fewer if the smallest node of the partition has
-# fewer, so the tasks can start; a request larger than any node would leave
-# them PENDING (PartitionConfig) for ever), SWEEP_ARGS (the sweep's options:
+# fewer, so the tasks can start; a request no node can hold, which Slurm would
+# leave PENDING (PartitionConfig) for ever, is refused before submitting), SWEEP_ARGS (the sweep's options:
 # every shard must get the same ones, or the merge refuses their different
 # sweep hashes), SBATCH_ARGS (more sbatch options: --partition, --account).
 #
