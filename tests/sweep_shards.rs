@@ -422,10 +422,14 @@ fn the_slurm_recipe_submits_and_retries_shards() {
         use std::os::unix::fs::PermissionsExt;
         std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
     };
+    // --test-only as Slurm 22.05 answers it on a 2-CPU node.
     stub(
         "sbatch",
         &format!(
-            "echo \"$* | SWEEP_ARGS=$SWEEP_ARGS\" >> '{}'; echo 4242",
+            "case \"$*\" in *--test-only*--cpus-per-task=[12]\\ *) exit 0 ;;\n\
+             *--test-only*) echo 'allocation failure: Requested node configuration is not \
+             available' >&2; exit 1 ;; esac\n\
+             echo \"$* | SWEEP_ARGS=$SWEEP_ARGS\" >> '{}'; echo 4242",
             calls.display()
         ),
     );
@@ -436,17 +440,19 @@ fn the_slurm_recipe_submits_and_retries_shards() {
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let launch = |args: &[&str]| {
+    let launch_with = |args: &[&str], env: &[(&str, &str)]| {
         let mut c = Command::new("bash");
         c.arg(&recipe).args(args).env("PATH", &path);
         for k in SHARD_ENV
             .iter()
-            .chain(&["CPUS", "SHARDS", "SWEEP_ARGS", "OUT"])
+            .chain(&["CPUS", "SHARDS", "SWEEP_ARGS", "OUT", "SBATCH_ARGS"])
         {
             c.env_remove(k);
         }
+        c.envs(env.iter().copied());
         c.env("OUT", dir.join("out")).output().unwrap()
     };
+    let launch = |args: &[&str]| launch_with(args, &[]);
     let out = launch(&[]);
     assert!(
         out.status.success(),
@@ -462,6 +468,17 @@ fn the_slurm_recipe_submits_and_retries_shards() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("shards 2 of 3"));
     let bad = launch(&["4"]);
     assert_eq!(bad.status.code(), Some(2));
+    // More CPUs than any node: refused before submitting (Slurm would leave
+    // the tasks PENDING (PartitionConfig) for ever), saying what to set.
+    let big = launch_with(&[], &[("CPUS", "8")]);
+    let stderr = String::from_utf8_lossy(&big.stderr);
+    assert_eq!(big.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("8 CPUs")
+            && stderr.contains("Requested node configuration is not available")
+            && stderr.contains("set CPUS"),
+        "{stderr}"
+    );
     let text = std::fs::read_to_string(&calls).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 4, "{text}");
@@ -516,6 +533,31 @@ fn the_slurm_recipe_submits_and_retries_shards() {
     assert!(stderr.contains("shard 2/3 by id hash"), "{stderr}");
     let list: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(list["shard"], "hash:2/3");
+
+    // `sbatch --array=1,4,9` of the recipe itself (SHARDS 3): task 1 refuses
+    // too, before any work, so no shard of it renders.
+    let out = Command::new("bash")
+        .arg(&recipe)
+        .env("DERMIS", env!("CARGO_BIN_EXE_dermis"))
+        .env("OUT", dir.join("irregular"))
+        .env("SWEEP_ARGS", with(&[])[1..].join(" "))
+        .env_remove("DERMIS_SHARD")
+        .env_remove("DERMIS_SHARD_TOTAL")
+        .env_remove("SHARDS")
+        .envs([
+            ("SLURM_ARRAY_TASK_ID", "1"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+            ("SLURM_ARRAY_TASK_MAX", "9"),
+            ("SLURM_ARRAY_TASK_STEP", "1"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("MIN=1 to MAX=9"), "{stderr}");
+    let written: Vec<_> = std::fs::read_dir(dir.join("irregular")).unwrap().collect();
+    assert!(written.is_empty(), "{written:?}");
 }
 
 /// Two sweeps into one --out-dir at once: the second is refused before any
@@ -550,4 +592,125 @@ fn a_second_sweep_into_one_folder_is_refused() {
         .collect();
     assert_eq!(records, ["header", "point", "point"]);
     assert!(out_dir.join("sweep.json").is_file());
+}
+
+/// docs/recipes/k8s-sweep-job.yaml and github-sweep.yml as their schedulers
+/// would run them (neither runs here: no cluster, no GitHub; see
+/// docs/records/2026-11-29-slurm-recipe.md): the Job's command with each
+/// JOB_COMPLETION_INDEX, the workflow's --shard expression with each matrix
+/// job's strategy.job-index, give shards 1..N of N that cover the sweep once.
+#[test]
+fn the_k8s_and_github_recipes_shard_as_documented() {
+    let recipes = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/recipes");
+    let read = |name: &str| {
+        std::fs::read_to_string(recipes.join(name))
+            .unwrap_or_else(|e| panic!("docs/recipes/{name}: {e}"))
+    };
+    let line_after = |text: &str, key: &str| -> String {
+        let line = text
+            .lines()
+            .find(|l| l.contains(key))
+            .unwrap_or_else(|| panic!("no line with {key:?}"));
+        line[line.find(key).unwrap() + key.len()..]
+            .trim()
+            .to_string()
+    };
+    // The tiny sweep's options, less --frames (the recipes give their own).
+    let frames = SWEEP.iter().position(|a| *a == "--frames").unwrap();
+    let tiny: Vec<String> = with(&["--list-points", "--json"])
+        .into_iter()
+        .enumerate()
+        .filter(|&(i, _)| i != 0 && i != frames && i != frames + 1)
+        .map(|(_, a)| a)
+        .collect();
+    let all = ids(&serde_json::from_slice(
+        &dermis(&with(&["--list-points", "--json"]), &[]).stdout,
+    )
+    .unwrap());
+    assert_eq!(all.len(), 2);
+    let covers = |shards: Vec<Value>, n: usize, what: &str| {
+        let mut seen: Vec<String> = Vec::new();
+        for (i, list) in shards.iter().enumerate() {
+            assert_eq!(list["shard"], format!("hash:{}/{n}", i + 1), "{what}");
+            seen.extend(ids(list));
+        }
+        seen.sort();
+        let mut want = all.clone();
+        want.sort();
+        assert_eq!(seen, want, "{what}: every point in exactly one shard");
+    };
+
+    // Kubernetes: completions = DERMIS_SHARD_TOTAL; the pod's command as given.
+    let k8s = read("k8s-sweep-job.yaml");
+    let n: usize = line_after(&k8s, "completions:").parse().unwrap();
+    let total_line = k8s
+        .lines()
+        .skip_while(|l| !l.contains("- name: DERMIS_SHARD_TOTAL"))
+        .nth(1)
+        .unwrap();
+    assert!(
+        total_line.contains(&format!("value: \"{n}\"")),
+        "DERMIS_SHARD_TOTAL must equal completions ({n}): {total_line}"
+    );
+    let command: Vec<String> = serde_json::from_str(&line_after(&k8s, "command: ")).unwrap();
+    assert_eq!(command[..4], ["dermis", "sweep", "--shard", "auto"]);
+    let out_dir = tmp("k8s");
+    let pods: Vec<Value> = (0..n)
+        .map(|index| {
+            let mut args: Vec<String> = command[1..]
+                .iter()
+                .map(|a| {
+                    if a == "/results" {
+                        out_dir.display().to_string()
+                    } else {
+                        a.clone()
+                    }
+                })
+                .collect();
+            args.extend(tiny.iter().cloned());
+            let out = dermis(
+                &args,
+                &[
+                    ("JOB_COMPLETION_INDEX", &index.to_string()),
+                    ("DERMIS_SHARD_TOTAL", &n.to_string()),
+                ],
+            );
+            let stderr = check(&format!("pod {index}"), &out);
+            assert!(
+                stderr.contains(&format!("(from JOB_COMPLETION_INDEX={index})")),
+                "{stderr}"
+            );
+            serde_json::from_slice(&out.stdout).unwrap()
+        })
+        .collect();
+    covers(pods, n, "k8s-sweep-job.yaml");
+
+    // GitHub: the matrix's entries are the jobs; bash evaluates the --shard
+    // expression once GitHub has substituted ${{ … }}.
+    let gh = read("github-sweep.yml");
+    let matrix = line_after(&gh, "shard: [");
+    let n = matrix[..matrix.find(']').unwrap()].split(',').count();
+    let expression = line_after(&gh, "--shard $((");
+    let expression = format!("$(({}", expression.trim_end_matches('\\').trim());
+    let jobs: Vec<Value> = (0..n)
+        .map(|index| {
+            let script = expression
+                .replace("${{ strategy.job-index }}", &index.to_string())
+                .replace("${{ strategy.job-total }}", &n.to_string());
+            let shard = Command::new("bash")
+                .args(["-c", &format!("echo {script}")])
+                .output()
+                .unwrap();
+            let shard = String::from_utf8(shard.stdout).unwrap().trim().to_string();
+            assert_eq!(shard, format!("{}/{n}", index + 1), "{expression}");
+            let mut args = vec!["--shard".to_string(), shard];
+            args.extend(tiny.iter().cloned());
+            let mut full = vec!["sweep".to_string()];
+            full.extend(args);
+            let out = dermis(&full, &[]);
+            check(&format!("matrix job {index}"), &out);
+            serde_json::from_slice(&out.stdout).unwrap()
+        })
+        .collect();
+    covers(jobs, n, "github-sweep.yml");
 }

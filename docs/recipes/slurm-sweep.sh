@@ -21,15 +21,16 @@
 # Knobs (environment, or edit here): DERMIS (binary), OUT (shared folder),
 # SHARDS (tasks; every submission of one sweep must use the same), CPUS (cores
 # per task; default: 8, or fewer if the smallest node of the partition has
-# fewer, so the tasks can start; a request larger than any node would leave
-# them PENDING (PartitionConfig) for ever), SWEEP_ARGS (the sweep's options:
+# fewer, so the tasks can start; a request no node can hold, which Slurm would
+# leave PENDING (PartitionConfig) for ever, is refused before submitting), SWEEP_ARGS (the sweep's options:
 # every shard must get the same ones, or the merge refuses their different
 # sweep hashes), SBATCH_ARGS (more sbatch options: --partition, --account).
 #
 # (`sbatch --array=1-3 docs/recipes/slurm-sweep.sh` submits the array alone with
 # the directives below; merge by hand afterwards with
 # `dermis sweep merge $OUT --out-dir $OUT/merged`. Run that way, the task count
-# must equal SHARDS (default 3): dermis refuses a mismatch.)
+# must equal SHARDS (default 3): dermis refuses a mismatch; and nothing checks
+# --cpus-per-task: edit it below to at most a node's CPUs, `sinfo -o %c`.)
 #SBATCH --job-name=dermis-sweep
 #SBATCH --cpus-per-task=2
 #SBATCH --time=02:00:00
@@ -73,7 +74,17 @@ if [ -z "${SLURM_ARRAY_TASK_ID:-}" ]; then
         fi
     fi
     export DERMIS OUT SHARDS SWEEP_ARGS
+    # Slurm accepts a task no node can hold and leaves it PENDING
+    # (PartitionConfig) for ever (EnforcePartLimits=NO, the default): ask it
+    # first whether the array can ever run (sbatch --test-only, Slurm 22.05).
     # shellcheck disable=SC2086 # SBATCH_ARGS is a list of options
+    if ! why=$(sbatch --test-only --array="$indices" --cpus-per-task="$CPUS" \
+        ${SBATCH_ARGS:-} "$script" 2>&1); then
+        echo "$0: Slurm cannot run a task of $CPUS CPUs here: $why" >&2
+        echo "(set CPUS to at most a node's CPU count, \`sinfo -o %c\`, or fix SBATCH_ARGS)" >&2
+        exit 2
+    fi
+    # shellcheck disable=SC2086
     job=$(sbatch --parsable --export=ALL --array="$indices" --cpus-per-task="$CPUS" \
         ${SBATCH_ARGS:-} "$script")
     job=${job%%;*}

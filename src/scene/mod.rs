@@ -7,6 +7,7 @@ pub mod env;
 pub mod file;
 pub mod gltf;
 pub mod head;
+pub mod jpeg_scan;
 pub mod mesh;
 pub mod overrides;
 pub mod range;

@@ -118,6 +118,7 @@ fn decode_texture(bytes: &[u8], encoding: Encoding) -> Result<Texture, String> {
         Some(ImageFormat::Png) => check_png_complete(bytes)?,
         Some(ImageFormat::Jpeg) => {
             check_jpeg_complete(bytes)?;
+            super::jpeg_scan::check_scans(bytes)?;
             return decode_jpeg_strict(bytes, encoding);
         }
         _ => return Err("not a PNG or JPEG image".into()),
@@ -476,26 +477,13 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
-    /// Bytes of the scan's entropy-coded data changed (not truncated): a lenient
-    /// decoder renders them as garbage blocks silently. Strict decoding refuses
-    /// every change it can detect: a run of one bits (stuffed FF 00 pairs) is
-    /// no Huffman code of any table, so it is always refused; random bytes
-    /// mostly still decode as valid (different) codes, which no decoder can
-    /// tell from data (libjpeg only counts bytes left over at the end).
+    /// A run of one bits (stuffed FF 00 pairs) in the scan is no Huffman code of
+    /// any table: always refused, by the decoder or the scan walk.
     #[test]
-    fn corrupt_jpeg_scans_are_refused() {
+    fn runs_of_ones_in_a_jpeg_scan_are_refused() {
         let jpg = std::fs::read(assets().join("Map-COL.jpg")).unwrap();
-        let original = decode_texture(&jpg, Encoding::Srgb).unwrap();
-        // The first SOS segment's data: after FF DA and its length.
-        let sos = jpg.windows(2).position(|w| w == [0xFF, 0xDA]).unwrap();
-        let data = sos + 2 + usize::from(u16::from_be_bytes([jpg[sos + 2], jpg[sos + 3]]));
-        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            rng
-        };
+        let data = scan_data(&jpg).start;
+        let mut next = xorshift(0x9E37_79B9_7F4A_7C15);
         for _ in 0..20 {
             let mut bytes = jpg.clone();
             let at = data + 64 + (next() as usize) % 8192;
@@ -508,34 +496,264 @@ mod tests {
             assert!(msg.starts_with("corrupt JPEG"), "{msg}");
             assert!(!msg.contains('\n'), "{msg}");
         }
-        let (mut refused, mut changed, mut same) = (0, 0, 0);
-        for _ in 0..40 {
-            let mut bytes = jpg.clone();
-            let at = data + 64 + (next() as usize) % 8192;
+    }
+
+    /// xorshift64 (Marsaglia 2003): deterministic mutants without a crate.
+    fn xorshift(seed: u64) -> impl FnMut() -> u64 {
+        let mut x = seed;
+        move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        }
+    }
+
+    /// The entropy-coded bytes of a one-scan JPEG: after the SOS header, before
+    /// the final FF D9.
+    fn scan_data(jpg: &[u8]) -> std::ops::Range<usize> {
+        let sos = jpg.windows(2).position(|w| w == [0xFF, 0xDA]).unwrap();
+        let start = sos + 2 + usize::from(u16::from_be_bytes([jpg[sos + 2], jpg[sos + 3]]));
+        assert_eq!(&jpg[jpg.len() - 2..], [0xFF, 0xD9]);
+        start..jpg.len() - 2
+    }
+
+    /// The textures mutated, and how many mutants of each.
+    const MUTATED: [&str; 3] = [
+        "Map-COL.jpg",
+        "Map-SPEC.jpg",
+        "Infinite-Level_02_Tangent_SmoothUV.jpg",
+    ];
+    const MUTANTS_PER_FILE: usize = 40;
+
+    /// Deterministic mutants of a texture's scan data, named by what was done:
+    /// one byte replaced, one bit flipped, 16 bytes replaced, the scan cut
+    /// short (end marker kept), one byte deleted, one byte inserted.
+    fn mutants(jpg: &[u8], seed: u64) -> Vec<(String, Vec<u8>)> {
+        let data = scan_data(jpg);
+        let mut next = xorshift(seed);
+        let mut out = Vec::new();
+        for i in 0..MUTANTS_PER_FILE {
+            let at = data.start + (next() as usize) % (data.len() - 16);
             let r = next();
-            for (k, b) in bytes[at..at + 16].iter_mut().enumerate() {
-                *b = (r >> (k % 8 * 8)) as u8 & 0x7F;
-            }
-            match decode_texture(&bytes, Encoding::Srgb) {
-                Err(msg) => {
-                    assert!(msg.starts_with("corrupt JPEG"), "{msg}");
-                    refused += 1
+            let mut b = jpg.to_vec();
+            let name = match i % 6 {
+                0 => {
+                    b[at] ^= (r % 255 + 1) as u8; // never the same byte
+                    format!("byte {at} replaced")
                 }
-                Ok(t) if t.rgba8 != original.rgba8 => changed += 1,
-                Ok(_) => same += 1,
+                1 => {
+                    b[at] ^= 1 << (r % 8);
+                    format!("bit {} of byte {at} flipped", r % 8)
+                }
+                2 => {
+                    for (k, x) in b[at..at + 16].iter_mut().enumerate() {
+                        *x = (r >> (k % 8 * 8)) as u8;
+                    }
+                    format!("bytes {at}..{} replaced", at + 16)
+                }
+                3 => {
+                    b.truncate(at);
+                    b.extend_from_slice(&[0xFF, 0xD9]);
+                    format!("scan cut at byte {at}")
+                }
+                4 => {
+                    b.remove(at);
+                    format!("byte {at} deleted")
+                }
+                _ => {
+                    b.insert(at, r as u8);
+                    format!("byte inserted at {at}")
+                }
+            };
+            out.push((name, b));
+        }
+        out
+    }
+
+    /// libjpeg's verdict on each mutant of each file (djpeg of libjpeg-turbo
+    /// 2.1.5, Debian 12; `libjpeg_and_dermis_agree_on_corrupt_jpegs` measures
+    /// it): `W`, it warned "Corrupt JPEG data" (exit 2); `.`, it decoded the
+    /// mutant without a word. docs/records/2026-11-29-corrupt-jpeg.md.
+    const LIBJPEG: [&str; 3] = [
+        "...WW....W.....W.W..WW.....WW.WWWW.W...W",
+        ".WWW.W.W.WWW...WWW...WW.W.WW..W.WW.WW.WW",
+        "..WW....WW...WWW.....W.W...W..W.WW...WWW",
+    ];
+
+    /// Every mutant libjpeg reports as corrupt is refused, the message naming
+    /// the file and the damage (libjpeg's "Corrupt JPEG data" warnings are
+    /// refusals here: a texture decoded from them is wrong without a sign).
+    #[test]
+    fn corrupt_jpeg_scans_are_refused() {
+        let dir = temp_dir("mutants");
+        let (mut refused, mut accepted) = (0, 0);
+        for (f, file) in MUTATED.into_iter().enumerate() {
+            let jpg = std::fs::read(assets().join(file)).unwrap();
+            for (i, (what, bytes)) in mutants(&jpg, 0x9E37_79B9_7F4A_7C15 + f as u64)
+                .into_iter()
+                .enumerate()
+            {
+                let path = dir.join(format!("mutant-{i}-{file}"));
+                std::fs::write(&path, &bytes).unwrap();
+                let result = load_texture(&path, Encoding::Srgb);
+                if LIBJPEG[f].as_bytes()[i] == b'.' {
+                    accepted += 1;
+                    continue;
+                }
+                let msg = result
+                    .err()
+                    .unwrap_or_else(|| panic!("{file} mutant {i} ({what}) loaded"))
+                    .to_string();
+                assert!(msg.contains(&format!("mutant-{i}-{file}")), "{msg}");
+                assert!(
+                    msg.contains("corrupt JPEG") || msg.contains("truncated JPEG"),
+                    "{msg}"
+                );
+                assert!(!msg.contains('\n'), "{msg}");
+                refused += 1;
             }
         }
-        println!(
-            "random scan bytes: {refused} refused, {changed} decoded differently, {same} the same"
-        );
-        assert!(refused > 0);
+        println!("mutants: {refused} refused as libjpeg does, {accepted} libjpeg accepts");
+        assert_eq!(refused + accepted, MUTATED.len() * MUTANTS_PER_FILE);
         // The scan's textures still load.
-        for name in [
-            "Map-COL.jpg",
-            "Map-SPEC.jpg",
-            "Infinite-Level_02_Tangent_SmoothUV.jpg",
-        ] {
+        for name in MUTATED {
             load_texture(&assets().join(name), Encoding::Srgb).unwrap();
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The measurement behind `LIBJPEG` (needs `djpeg`, libjpeg-turbo-progs;
+    /// `cargo test --release --lib libjpeg_and_dermis -- --ignored --nocapture`):
+    /// djpeg's verdict on every mutant (exit 0 clean, 2 warned, 1 failed) beside
+    /// dermis's, and whether the decoded pixels differ from the original's.
+    #[test]
+    #[ignore = "needs djpeg (libjpeg-turbo-progs)"]
+    fn libjpeg_and_dermis_agree_on_corrupt_jpegs() {
+        use std::io::Write;
+        let (mut n, mut libjpeg_flags, mut dermis_flags, mut changed) = (0, 0, 0, 0);
+        let mut zune_flags = 0;
+        let mut verdicts = Vec::new();
+        for (f, file) in MUTATED.into_iter().enumerate() {
+            let jpg = std::fs::read(assets().join(file)).unwrap();
+            let original = decode_texture(&jpg, Encoding::Srgb).unwrap();
+            // What the scan walk costs beside the decode (release build).
+            let clock = std::time::Instant::now();
+            super::super::jpeg_scan::check_scans(&jpg).unwrap();
+            let walk = clock.elapsed();
+            decode_jpeg_strict(&jpg, Encoding::Srgb).unwrap();
+            println!(
+                "{file}: scan walk {:.1} ms, decode {:.1} ms",
+                walk.as_secs_f64() * 1e3,
+                (clock.elapsed() - walk).as_secs_f64() * 1e3
+            );
+            let mut verdict = String::new();
+            for (i, (what, bytes)) in mutants(&jpg, 0x9E37_79B9_7F4A_7C15 + f as u64)
+                .into_iter()
+                .enumerate()
+            {
+                let mut child = std::process::Command::new("djpeg")
+                    .args(["-outfile", "/dev/null"])
+                    .stdin(std::process::Stdio::piped())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .expect("djpeg runs (apt-get install libjpeg-turbo-progs)");
+                child.stdin.take().unwrap().write_all(&bytes).unwrap();
+                let out = child.wait_with_output().unwrap();
+                let libjpeg = String::from_utf8_lossy(&out.stderr)
+                    .trim()
+                    .replace('\n', "; ");
+                let flagged = !out.status.success();
+                let dermis = decode_texture(&bytes, Encoding::Srgb);
+                let differs = match &dermis {
+                    Ok(t) => t.rgba8 != original.rgba8,
+                    // Refused: decode leniently to see whether it would differ.
+                    Err(_) => image::load_from_memory(&bytes)
+                        .map(|im| im.to_rgba8().into_raw() != original.rgba8)
+                        .unwrap_or(true),
+                };
+                println!(
+                    "{file} #{i} ({what}): libjpeg {:?} {libjpeg:?}; dermis {}; pixels {}",
+                    out.status.code(),
+                    match &dermis {
+                        Ok(_) => "loads".to_string(),
+                        Err(m) => format!("refuses: {m}"),
+                    },
+                    if differs { "differ" } else { "same" }
+                );
+                n += 1;
+                libjpeg_flags += usize::from(flagged);
+                dermis_flags += usize::from(dermis.is_err());
+                changed += usize::from(differs);
+                verdict.push(if flagged { 'W' } else { '.' });
+                // Before the scan walk: the end marker and zune-jpeg's strict mode.
+                let zune = check_jpeg_complete(&bytes)
+                    .and_then(|()| decode_jpeg_strict(&bytes, Encoding::Srgb));
+                zune_flags += usize::from(zune.is_err());
+                assert!(
+                    !flagged || dermis.is_err(),
+                    "{file} mutant {i} ({what}): libjpeg says {libjpeg:?}, dermis loads it"
+                );
+            }
+            verdicts.push(verdict);
+        }
+        println!(
+            "{n} mutants: {changed} decode to other pixels, libjpeg flags {libjpeg_flags}, \
+             dermis refuses {dermis_flags} (zune-jpeg strict alone: {zune_flags}); \
+             libjpeg: {verdicts:?}"
+        );
+        assert_eq!(verdicts, LIBJPEG, "update LIBJPEG");
+    }
+
+    /// Restart markers (none in the repository's JPEGs): a scan re-encoded by
+    /// `cjpeg -restart 4B` (every 4 MCUs) loads; one RST renumbered or removed is refused, as
+    /// libjpeg warns about both (needs cjpeg and djpeg, libjpeg-turbo-progs).
+    #[test]
+    #[ignore = "needs cjpeg and djpeg (libjpeg-turbo-progs)"]
+    fn restart_markers_are_checked() {
+        use std::io::Write;
+        use std::process::{Command, Stdio};
+        let pipe = |program: &str, args: &[&str], input: &[u8]| {
+            let mut child = Command::new(program)
+                .args(args)
+                .stdin(Stdio::piped())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap_or_else(|e| panic!("{program}: {e}"));
+            let mut stdin = child.stdin.take().unwrap();
+            let input = input.to_vec();
+            let writer = std::thread::spawn(move || stdin.write_all(&input));
+            let out = child.wait_with_output().unwrap();
+            writer.join().unwrap().unwrap();
+            out
+        };
+        let t = load_texture(&assets().join("Map-COL.jpg"), Encoding::Srgb).unwrap();
+        let mut ppm = format!("P6\n{} {}\n255\n", t.width, t.height).into_bytes();
+        for p in t.rgba8.chunks_exact(4) {
+            ppm.extend_from_slice(&p[..3]);
+        }
+        let jpg = pipe("cjpeg", &["-restart", "4B"], &ppm).stdout;
+        decode_texture(&jpg, Encoding::Srgb).unwrap();
+        let rst: Vec<usize> = (0..jpg.len() - 1)
+            .filter(|&i| jpg[i] == 0xFF && (0xD0..=0xD7).contains(&jpg[i + 1]))
+            .collect();
+        assert!(rst.len() > 100, "{} restart markers", rst.len());
+        let mut renumbered = jpg.clone();
+        renumbered[rst[40] + 1] = 0xD0 + (renumbered[rst[40] + 1] - 0xD0 + 3) % 8;
+        let mut removed = jpg.clone();
+        removed.drain(rst[40]..rst[40] + 2);
+        for (what, bytes) in [("renumbered", renumbered), ("removed", removed)] {
+            let libjpeg = pipe("djpeg", &["-outfile", "/dev/null"], &bytes);
+            assert_eq!(libjpeg.status.code(), Some(2), "libjpeg, RST {what}");
+            let msg = decode_texture(&bytes, Encoding::Srgb)
+                .err()
+                .unwrap_or_else(|| panic!("RST {what}: loaded"));
+            println!(
+                "RST {what}: libjpeg {:?}; dermis {msg}",
+                String::from_utf8_lossy(&libjpeg.stderr).trim()
+            );
+            assert!(msg.starts_with("corrupt JPEG"), "{msg}");
         }
     }
 

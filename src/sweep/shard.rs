@@ -228,6 +228,22 @@ fn from_env(mode: Mode, env: &dyn Fn(&str) -> Option<String>) -> Result<Resolved
                      DERMIS_SHARD_TOTAL={count}"
                 )));
             }
+            // Every task of an array that names a task outside 1..=total
+            // refuses (SLURM_ARRAY_TASK_MIN and MAX are the array's, the same
+            // in each task): none renders a shard of a submission that cannot
+            // complete, e.g. --array=1,4,9 with 3 shards.
+            let range = (num("SLURM_ARRAY_TASK_MIN")?, num("SLURM_ARRAY_TASK_MAX")?);
+            if let (Some(min), Some(max)) = range {
+                if min == 0 || max > total {
+                    return Err(Error::Input(format!(
+                        "--shard auto: with DERMIS_SHARD_TOTAL={total} the Slurm task IDs are \
+                         the shard numbers, 1..={total}, but this array's tasks run from \
+                         SLURM_ARRAY_TASK_MIN={min} to MAX={max}; no task of it renders \
+                         (submit --array=1-{total}, or a retry's --array=I,J with each in \
+                         1..={total})"
+                    )));
+                }
+            }
             if id == 0 || id > total {
                 return Err(Error::Input(format!(
                     "--shard auto: with DERMIS_SHARD_TOTAL={total} the Slurm task ID is the \
@@ -564,6 +580,23 @@ mod tests {
             ("DERMIS_SHARD_TOTAL", "3"),
         ];
         assert_eq!(shard_of(Some("auto"), &list), (3, 3, Mode::Hash));
+        // A list naming tasks past the total (--array=1,4,9 with 3 shards):
+        // every task refuses, task 1 too, so none renders (issue 45, item 4).
+        for id in ["1", "4", "9"] {
+            let env = [
+                ("SLURM_ARRAY_TASK_ID", id),
+                ("SLURM_ARRAY_TASK_MIN", "1"),
+                ("SLURM_ARRAY_TASK_MAX", "9"),
+                ("SLURM_ARRAY_TASK_STEP", "1"),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+                ("DERMIS_SHARD_TOTAL", "3"),
+            ];
+            let e = resolved(Some("auto"), &env).unwrap_err().to_string();
+            assert!(
+                e.contains("SLURM_ARRAY_TASK_MIN=1 to MAX=9") && e.contains("1..=3"),
+                "task {id}: {e}"
+            );
+        }
         // The total disagreeing with the array, or an ID outside it: refused.
         for (env, needle) in [
             (
