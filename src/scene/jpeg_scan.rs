@@ -6,7 +6,7 @@
 //! (JWRN_EXTRANEOUS_DATA) and a missing or misnumbered restart marker
 //! (JWRN_MUST_RESYNC). zune-jpeg's strict mode finds none of the last three:
 //! it fills a short scan with zeros and ignores leftover bytes, so most random
-//! byte changes in the scan decode silently to wrong pixels (issue 45, item 18).
+//! byte changes in the scan decode silently to wrong pixels.
 //! A changed byte desynchronises the codes after it, so the scan almost
 //! always ends off its last byte; that is what libjpeg (and this walk) sees.
 //!
