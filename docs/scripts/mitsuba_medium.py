@@ -13,13 +13,15 @@ docs/scripts/cycles_compare.py reads as a reference: Combined.{R,G,B,A} (linear
 radiance, alpha = coverage) and Position.{X,Y,Z} (the first surface hit, dermis
 world mm).
 
-Scenes (match dermis's with the same camera, size and lights; docs/scenes/):
+Scenes (match dermis's with the same camera, size and sky; docs/scenes/):
   uniform   a uniform sky of radiance 1 (docs/scenes/skin1-uniform.toml)
-  sun       a uniform sky of radiance 0.25 and a sun: a directional light of
-            irradiance pi travelling along SUN_DIRECTION (docs/scenes/skin1-sun.toml)
-  backlit   the left side of the head, lit from behind by a directional light of
-            irradiance pi travelling along BACK_DIRECTION, under a sky of
-            radiance 0.02 (docs/scenes/skin1-backlit.toml)
+  backlit   the left side of the head under BACK_SKY: radiance 0.02 + 2·max(0, -z)^2,
+            the light from behind the head (docs/scenes/skin1-backlit.toml, whose
+            docs/scenes/back-sky.exr `--write-back-sky` writes)
+Small or delta lights (a sun) cannot be compared this way: volpath reaches the
+medium only by unidirectional paths (no shadow ray crosses the dielectric
+boundary), so a directional light lights the boundary's reflection and never
+the interior.
 
     pip install mitsuba
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \\
@@ -33,7 +35,6 @@ Units: mm, mm^-1.
 """
 import argparse
 import json
-import math
 import os
 import struct
 import sys
@@ -44,15 +45,36 @@ import numpy as np
 MM_PER_UNIT = 50.3
 HERE = os.path.dirname(os.path.abspath(__file__))
 GLB = os.path.join(HERE, "..", "..", "assets", "head", "lee-perry-smith", "LeePerrySmith.glb")
-# Directions the lights travel (from the light into the scene), dermis world.
-SUN_DIRECTION = [-0.5, -0.6, -1.0]
-BACK_DIRECTION = [-0.3, -0.2, 1.0]
 SCENES = {
-    # camera position, target (mm), vertical field of view (deg), size, sky, lights
-    "uniform": ([229, 119, 629], [0, 60, 0], 30.0, (256, 320), 1.0, []),
-    "sun": ([229, 119, 629], [0, 60, 0], 30.0, (256, 320), 0.25, [(SUN_DIRECTION, math.pi)]),
-    "backlit": ([-400, 65, -10], [-80, 65, -10], 30.0, (256, 320), 0.02, [(BACK_DIRECTION, math.pi)]),
+    # camera position, target (mm), vertical field of view (deg), size, sky
+    "uniform": ([229, 119, 629], [0, 60, 0], 30.0, (256, 320), "uniform"),
+    "backlit": ([-400, 65, -10], [-80, 65, -10], 30.0, (256, 320), "back"),
 }
+BACK_SKY_SIZE = (256, 128)
+
+
+def back_sky():
+    """BACK_SKY as a lat-long map in dermis's convention (src/scene/env/map.rs:
+    u = atan2(x, -z)/2pi + 0.5, v = acos(y)/pi), linear RGB, float32."""
+    w, h = BACK_SKY_SIZE
+    u = (np.arange(w) + 0.5) / w
+    v = (np.arange(h) + 0.5) / h
+    theta, phi = np.pi * v[:, None], 2 * np.pi * (u[None, :] - 0.5)
+    z = -np.sin(theta) * np.cos(phi)
+    radiance = 0.02 + 2.0 * np.maximum(0.0, -z) ** 2
+    return np.repeat(radiance[..., None], 3, -1).astype(np.float32)
+
+
+def write_exr(path, channels):
+    import OpenEXR
+
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    tmp = f"{path}.tmp-{os.getpid()}.exr"
+    with OpenEXR.File(header, channels) as f:
+        f.write(tmp)
+    os.replace(tmp, path)
+
+
 # Jensen et al. 2001, Table 2 (skin1), mm^-1.
 SKIN1 = ([0.032, 0.17, 0.48], [0.74, 0.88, 1.01])
 
@@ -103,7 +125,7 @@ def write_ply(path, pos, nrm, tri):
 
 
 def scene_dict(mi, ply, scene, channel, args, spp, seed, aov=False):
-    origin, target, fov, (w, h), sky, lights = SCENES[scene]
+    origin, target, fov, (w, h), sky = SCENES[scene]
     if args.scale > 1:
         w, h = w // args.scale, h // args.scale
     sigma_a = args.sigma_a[channel]
@@ -154,13 +176,11 @@ def scene_dict(mi, ply, scene, channel, args, spp, seed, aov=False):
     if aov:
         # No emitters: the film's alpha is then the mesh's coverage.
         return d
-    d["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": [sky] * 3}}
-    for i, (direction, irradiance) in enumerate(lights):
-        d[f"light{i}"] = {
-            "type": "directional",
-            "direction": direction,
-            "irradiance": {"type": "rgb", "value": [irradiance] * 3},
-        }
+    if sky == "uniform":
+        d["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": [1.0] * 3}}
+    else:
+        # Mitsuba's envmap reads u = atan2(x, -z)/2pi: dermis's map turned by half.
+        d["sky"] = {"type": "envmap", "filename": args.back_sky_mitsuba}
     return d
 
 
@@ -171,7 +191,7 @@ def render(mi, ply, args, channel, seed):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--scene", choices=sorted(SCENES), required=True)
+    p.add_argument("--scene", choices=sorted(SCENES))
     p.add_argument("--sigma-a", type=float, nargs=3, default=SKIN1[0])
     p.add_argument("--sigma-s-prime", type=float, nargs=3, default=SKIN1[1])
     p.add_argument("--g", type=float, default=0.0)
@@ -183,13 +203,21 @@ def main():
                    help="render at 1/SCALE of the size: each pixel then averages SCALE x SCALE "
                    "of dermis's (cycles_compare.py --bins BINS/SCALE at the same bins)")
     p.add_argument("--variant", default="llvm_ad_rgb")
-    p.add_argument("--out", required=True, help="the reference EXR")
+    p.add_argument("--out", help="the reference EXR")
+    p.add_argument("--write-back-sky", metavar="EXR",
+                   help="write BACK_SKY in dermis's convention (docs/scenes/back-sky.exr) and exit")
     p.add_argument("--specular-only", action="store_true",
                    help="an interior that absorbs all it is given: the boundary's reflection "
                    "alone (dermis: --view specular)")
     args = p.parse_args()
-    if not args.out.endswith(".exr"):
+    if args.write_back_sky:
+        write_exr(args.write_back_sky, {"RGB": back_sky()})
+        print(f"wrote {args.write_back_sky}")
+        return 0
+    if not args.out or not args.out.endswith(".exr"):
         p.error("--out must end in .exr")
+    if not args.scene:
+        p.error("--scene is required")
     if not os.path.isdir(os.path.dirname(os.path.abspath(args.out))):
         p.error(f"no folder for {args.out}")
     if not (0 <= args.g < 1 and args.ior > 1 and args.roughness > 0 and args.spp > 0):
@@ -198,13 +226,14 @@ def main():
         p.error(f"no mesh {GLB}")
 
     import mitsuba as mi
-    import OpenEXR
 
     mi.set_variant(args.variant)
     pos, nrm, tri = read_glb(GLB)
     with tempfile.TemporaryDirectory() as tmp:
         ply = os.path.join(tmp, "head.ply")
         write_ply(ply, pos, nrm, tri)
+        args.back_sky_mitsuba = os.path.join(tmp, "back-sky.exr")
+        write_exr(args.back_sky_mitsuba, {"RGB": np.roll(back_sky(), BACK_SKY_SIZE[0] // 2, axis=1)})
         if args.specular_only:
             # An interior that absorbs what enters within 0.01 mm: what leaves
             # is the boundary's reflection alone.
@@ -222,12 +251,7 @@ def main():
     rgba = np.stack(channels + [alpha], -1).astype(np.float32)
     # Where the mesh covers a pixel only partly, the mean position is of its hits.
     position = (pp[..., -3:] / np.maximum(alpha, 1e-6)[..., None]).astype(np.float32)
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    out_channels = {"Combined": rgba, "Position": position}
-    tmp = f"{args.out}.tmp-{os.getpid()}.exr"
-    with OpenEXR.File(header, out_channels) as f:
-        f.write(tmp)
-    os.replace(tmp, args.out)
+    write_exr(args.out, {"Combined": rgba, "Position": position})
     print(f"wrote {args.out}")
     return 0
 
