@@ -3,7 +3,7 @@
 //! built-in head (it has a region map), and none is constant: each shows a
 //! quantity that varies over the head.
 
-mod common;
+use crate::common;
 
 use dermis::post::debug::DebugView;
 use dermis::render::sheet::{COLUMNS, TILE};

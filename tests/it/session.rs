@@ -3,7 +3,7 @@
 //! soft visibility) is computed by the first frame that needs it, whatever view
 //! came first, and frames that reuse it are the frames that computed it.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::{Context, Image};
 use dermis::graph::upload::Readback;
