@@ -14,6 +14,7 @@ mod counters;
 mod docs;
 mod graph_gpu;
 mod layers;
+mod pipeline_cache;
 mod post;
 mod reference_gpu;
 mod scene_render;

@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 use dermis::gpu::{Context, ContextOptions, ValidationLog};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 /// Runs `f` on a validated context, destroys the context, then asserts the layer
@@ -24,12 +25,23 @@ static ONE_CONTEXT: Mutex<()> = Mutex::new(());
 
 /// Like [`with_gpu`] but hands the log back instead of asserting on it.
 pub fn with_gpu_log<T>(f: impl FnOnce(&Arc<Context>) -> T) -> (T, Arc<ValidationLog>) {
+    // Compiled afresh: no test depends on what an earlier run left
+    // (tests/it/pipeline_cache.rs tests the cache itself).
+    with_gpu_cache_log(None, f)
+}
+
+/// Like [`with_gpu_log`], with the on-disk pipeline cache in `pipeline_cache`.
+pub fn with_gpu_cache_log<T>(
+    pipeline_cache: Option<&Path>,
+    f: impl FnOnce(&Arc<Context>) -> T,
+) -> (T, Arc<ValidationLog>) {
     // A test that failed while holding it must not fail the others.
     let _one = ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner());
     let ctx = Context::new(&ContextOptions {
         validation: true,
         device: std::env::var("DERMIS_DEVICE").ok(),
         display: None,
+        pipeline_cache: pipeline_cache.map(Path::to_path_buf),
     })
     .expect("a Vulkan device with VK_LAYER_KHRONOS_validation (see README)");
     let log = ctx.validation().expect("validation is on");
