@@ -5,7 +5,7 @@
 
 use dermis::gpu::{Context, ContextOptions, ValidationLog};
 use std::path::Path;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// Runs `f` on a validated context, destroys the context, then asserts the layer
 /// said nothing of warning or error severity.
@@ -23,6 +23,14 @@ pub fn with_gpu<T>(f: impl FnOnce(&Arc<Context>) -> T) -> T {
 /// anyway: lavapipe runs each context on every core.
 static ONE_CONTEXT: Mutex<()> = Mutex::new(());
 
+/// The device to the caller alone while the guard lives: what in-process GPU
+/// tests hold, and what a test takes around a `dermis` run whose timings it
+/// judges, so that no other test's GPU work shares the cores meanwhile.
+pub fn device_turn() -> MutexGuard<'static, ()> {
+    // A test that failed while holding it must not fail the others.
+    ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// Like [`with_gpu`] but hands the log back instead of asserting on it.
 pub fn with_gpu_log<T>(f: impl FnOnce(&Arc<Context>) -> T) -> (T, Arc<ValidationLog>) {
     // Compiled afresh: no test depends on what an earlier run left
@@ -35,8 +43,7 @@ pub fn with_gpu_cache_log<T>(
     pipeline_cache: Option<&Path>,
     f: impl FnOnce(&Arc<Context>) -> T,
 ) -> (T, Arc<ValidationLog>) {
-    // A test that failed while holding it must not fail the others.
-    let _one = ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner());
+    let _one = device_turn();
     let ctx = Context::new(&ContextOptions {
         validation: true,
         device: std::env::var("DERMIS_DEVICE").ok(),
