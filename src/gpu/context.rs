@@ -1,6 +1,7 @@
 //! Instance, device, queue, memory allocator and validation: the root every GPU
 //! object holds an `Arc` of, so that it is destroyed last.
 
+use super::pipeline_cache::{DeviceKey, PipelineCache};
 use super::validation::{messenger_info, ValidationLog, TEST_MESSAGE_VAR};
 use crate::error::{Error, Result, VkResultExt};
 use ash::vk;
@@ -8,6 +9,8 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use serde::Serialize;
 use std::ffi::{c_char, CStr};
 use std::mem::ManuallyDrop;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -22,10 +25,15 @@ pub struct ContextOptions {
     /// Present to windows of this display (the viewer): the instance gets the
     /// display's surface extensions and the device VK_KHR_swapchain.
     pub display: Option<raw_window_handle::RawDisplayHandle>,
+    /// The folder of the on-disk pipeline cache (`pipeline_cache.rs`), read
+    /// when the context is made and written when it ends; `None`: pipelines
+    /// are compiled afresh and nothing is kept.
+    pub pipeline_cache: Option<PathBuf>,
 }
 
 impl ContextOptions {
-    /// Options from the environment: `DERMIS_VALIDATION=1`, `DERMIS_DEVICE=<substring>`.
+    /// Options from the environment: `DERMIS_VALIDATION=1`, `DERMIS_DEVICE=<substring>`;
+    /// the pipeline cache in the cache folder (`cache::default_cache_dir`).
     pub fn from_env() -> Self {
         Self {
             validation: std::env::var("DERMIS_VALIDATION").is_ok_and(|v| v == "1"),
@@ -33,6 +41,7 @@ impl ContextOptions {
                 .ok()
                 .filter(|s| !s.is_empty()),
             display: None,
+            pipeline_cache: Some(crate::cache::default_cache_dir()),
         }
     }
 }
@@ -83,6 +92,9 @@ pub struct Context {
     pub physical: vk::PhysicalDevice,
     pub device: ash::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
+    pipeline_cache: PipelineCache,
+    /// Whether a pipeline was made through the cache (else it is not saved).
+    pipelines_made: AtomicBool,
     calibrated: Option<ash::ext::calibrated_timestamps::Device>,
     queue: Mutex<vk::Queue>,
     /// Held by work that must not wait behind another thread's (see [`Context::foreground`]).
@@ -178,6 +190,9 @@ impl Context {
         )?;
         info.calibrated_timestamps = calibration_offered(&entry, &instance, physical);
         let device = create_device(&instance, physical, queue_family, swapchain, &info)?;
+        let key = DeviceKey::of(&unsafe { instance.get_physical_device_properties(physical) });
+        let pipeline_cache = PipelineCache::new(&device, &key, options.pipeline_cache.as_deref())
+            .inspect_err(|_| unsafe { device.destroy_device(None) })?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -187,7 +202,10 @@ impl Context {
             allocation_sizes: Default::default(),
         })
         .map_err(|source| {
-            unsafe { device.destroy_device(None) };
+            unsafe {
+                device.destroy_pipeline_cache(pipeline_cache.raw, None);
+                device.destroy_device(None);
+            }
             Error::Alloc {
                 name: "allocator".into(),
                 source,
@@ -222,6 +240,8 @@ impl Context {
             physical,
             device,
             push_descriptor,
+            pipeline_cache,
+            pipelines_made: AtomicBool::new(false),
             calibrated,
             queue: Mutex::new(queue),
             foreground: Mutex::new(()),
@@ -258,6 +278,12 @@ impl Context {
     /// the context is dropped (leaks are reported at device destruction).
     pub fn validation(&self) -> Option<Arc<ValidationLog>> {
         self.validation.clone()
+    }
+
+    /// The cache every pipeline is made through.
+    pub(crate) fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipelines_made.store(true, Ordering::Relaxed);
+        self.pipeline_cache.raw
     }
 
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
@@ -315,6 +341,8 @@ impl Drop for Context {
         let _lifecycle = lifecycle();
         unsafe {
             let _ = self.device.device_wait_idle();
+            self.pipeline_cache
+                .save_and_destroy(&self.device, self.pipelines_made.load(Ordering::Relaxed));
             // Device memory goes back before the device itself.
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);

@@ -4,6 +4,7 @@
 mod cache;
 mod context;
 mod pipeline;
+mod pipeline_cache;
 mod reflect;
 mod resources;
 pub mod shaders;

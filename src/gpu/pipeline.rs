@@ -171,7 +171,7 @@ impl Pipeline {
             .push_next(&mut feedback_info);
         p.raw = unsafe {
             ctx.device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+                .create_compute_pipelines(ctx.pipeline_cache(), &[info], None)
         }
         .map_err(|(_, e)| e)
         .vk("vkCreateComputePipelines")?[0];
@@ -294,7 +294,7 @@ impl Pipeline {
             .push_next(&mut feedback_info);
         p.raw = unsafe {
             ctx.device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+                .create_graphics_pipelines(ctx.pipeline_cache(), &[info], None)
         }
         .map_err(|(_, e)| e)
         .vk("vkCreateGraphicsPipelines")?[0];

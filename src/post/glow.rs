@@ -194,7 +194,7 @@ mod tests {
                 "{v}: {k}"
             );
         }
-        // The test image of tests/post.rs: 160 pixels high.
+        // The test image of tests/it/post.rs: 160 pixels high.
         assert_eq!(level_for(0.008 * 160.0 * 160.0).0, 1);
         assert_eq!(level_for(0.0576 * 160.0 * 160.0).0, 3);
     }

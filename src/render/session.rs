@@ -123,7 +123,7 @@ impl Session {
             &self.ctx,
             "viewer frame",
             ImageDesc::new(w, h, ldr.desc.format),
-            // TRANSFER_SRC: it can be read back (tests/session.rs).
+            // TRANSFER_SRC: it can be read back (tests/it/session.rs).
             vk::ImageUsageFlags::TRANSFER_DST
                 | vk::ImageUsageFlags::SAMPLED
                 | vk::ImageUsageFlags::TRANSFER_SRC,

@@ -159,7 +159,7 @@ impl BlurChain {
     /// With shear the V pass's taps leave their column, and linear
     /// interpolation across a narrowed intermediate's columns would widen the
     /// blur along u by 1/6 of its texel² (13 % of a level's variance at 4×
-    /// narrower, tests/skin_diffusion.rs): `{name}_u` then keeps src's width
+    /// narrower, tests/it/skin_diffusion.rs): `{name}_u` then keeps src's width
     /// and `{name}_v` alone shrinks it.
     pub fn gaussian(
         &self,

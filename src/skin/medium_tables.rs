@@ -253,7 +253,7 @@ mod tests {
             0.0,
             1.4,
         );
-        // Made once per machine (the GPU test in tests/transmission.rs reads
+        // Made once per machine (the GPU test in tests/it/transmission.rs reads
         // the same cache); the checks below walk afresh.
         let t = MediumTables::load_or_compute(&m, &crate::cache::default_cache_dir());
         println!(

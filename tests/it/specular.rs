@@ -8,7 +8,7 @@
 //! - the furnace: a white and a grey sphere under a uniform sky, the whole
 //!   frame against the closed form.
 
-mod common;
+use crate::common;
 
 use dermis::light::extract::extract;
 use dermis::light::prefilter;

@@ -1,7 +1,7 @@
 //! The bound-by verdict on its known cases: the ruler copy is memory-bound, an
 //! all-arithmetic pass is shading-bound, a 1-texel dispatch is overhead.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::{Executor, Graph};

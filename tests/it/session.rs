@@ -3,7 +3,7 @@
 //! soft visibility) is computed by the first frame that needs it, whatever view
 //! came first, and frames that reuse it are the frames that computed it.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::{Context, Image};
 use dermis::graph::upload::Readback;
@@ -109,7 +109,7 @@ fn turning_the_environment_in_a_session_is_a_fresh_session_at_that_angle() {
 #[test]
 fn a_session_shows_uv_views_as_render_writes_them() {
     // The scan's maps have their UV origin at the bottom left: both paths flip
-    // its UV-space views (tests/views.rs checks render's against the UVs).
+    // its UV-space views (tests/it/views.rs checks render's against the UVs).
     let scene = scan((64, 80));
     let (shown, written) = common::with_gpu(|ctx| {
         let mut session = Session::new(ctx, scene.clone()).unwrap();
@@ -140,7 +140,7 @@ fn a_session_shows_uv_views_as_render_writes_them() {
         "mean |session - render|: {same:.3} 8-bit steps; against render flipped: {flipped:.3}"
     );
     // The session meters and encodes on the GPU, render on the CPU: the same
-    // functions (tests/tonemap.rs), at most rounding apart.
+    // functions (tests/it/tonemap.rs), at most rounding apart.
     assert!(same < 0.5 && flipped > 20.0, "{same} {flipped}");
 }
 

@@ -4,7 +4,8 @@
 #![allow(dead_code)]
 
 use dermis::gpu::{Context, ContextOptions, ValidationLog};
-use std::sync::{Arc, Mutex};
+use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// Runs `f` on a validated context, destroys the context, then asserts the layer
 /// said nothing of warning or error severity.
@@ -22,14 +23,32 @@ pub fn with_gpu<T>(f: impl FnOnce(&Arc<Context>) -> T) -> T {
 /// anyway: lavapipe runs each context on every core.
 static ONE_CONTEXT: Mutex<()> = Mutex::new(());
 
+/// The device to the caller alone while the guard lives: what in-process GPU
+/// tests hold, and what a test takes around a `dermis` run whose timings it
+/// judges, so that no other test's GPU work shares the cores meanwhile.
+pub fn device_turn() -> MutexGuard<'static, ()> {
+    // A test that failed while holding it must not fail the others.
+    ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// Like [`with_gpu`] but hands the log back instead of asserting on it.
 pub fn with_gpu_log<T>(f: impl FnOnce(&Arc<Context>) -> T) -> (T, Arc<ValidationLog>) {
-    // A test that failed while holding it must not fail the others.
-    let _one = ONE_CONTEXT.lock().unwrap_or_else(|p| p.into_inner());
+    // Compiled afresh: no test depends on what an earlier run left
+    // (tests/it/pipeline_cache.rs tests the cache itself).
+    with_gpu_cache_log(None, f)
+}
+
+/// Like [`with_gpu_log`], with the on-disk pipeline cache in `pipeline_cache`.
+pub fn with_gpu_cache_log<T>(
+    pipeline_cache: Option<&Path>,
+    f: impl FnOnce(&Arc<Context>) -> T,
+) -> (T, Arc<ValidationLog>) {
+    let _one = device_turn();
     let ctx = Context::new(&ContextOptions {
         validation: true,
         device: std::env::var("DERMIS_DEVICE").ok(),
         display: None,
+        pipeline_cache: pipeline_cache.map(Path::to_path_buf),
     })
     .expect("a Vulkan device with VK_LAYER_KHRONOS_validation (see README)");
     let log = ctx.validation().expect("validation is on");

@@ -2,7 +2,7 @@
 //! pixels as the GPU's `--view direct` of the default scene (the Lee Perry-Smith
 //! scan): the camera, pixel-centre and y conventions agree.
 
-mod common;
+use crate::common;
 
 use dermis::light::reference::{render_view, Settings};
 use dermis::render::{render_scene, RenderOptions, View};

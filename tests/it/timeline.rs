@@ -2,7 +2,7 @@
 //! host's clock. A CPU span that waits on a frame's fence ends after that
 //! frame's last GPU pass, with calibrated GPU timestamps and with host fences.
 
-mod common;
+use crate::common;
 
 use dermis::graph::upload::Readback;
 use dermis::graph::{Clock, Executor, Graph};

@@ -2,7 +2,7 @@
 //! §14.4; the paper's eq. 2-5): the real stretch pass and blur chain on flat
 //! planes whose UV scale is known, fed with chosen irradiance.
 
-mod common;
+use crate::common;
 
 use dermis::frame::MeshBuffers;
 use dermis::gpu::{Context, ImageDesc, Pipelines, Sampler};

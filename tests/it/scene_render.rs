@@ -2,7 +2,7 @@
 //! scan produce a sane image (the head covers the middle of the frame, nothing is
 //! NaN or black), and EXR output is the linear image behind the PNG.
 
-mod common;
+use crate::common;
 
 use dermis::render::{render_scene, RenderOptions, RenderOutput};
 use dermis::scene::file::{load_scene, SceneFile};

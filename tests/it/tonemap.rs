@@ -5,7 +5,7 @@
 //! and metered exposures (the GPU meter against post::meter::exposure), and the
 //! background where alpha (coverage) is 0.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::{upload_texture, Readback};

@@ -1,7 +1,7 @@
 //! SH projection on the GPU against the CPU reference (light::sh::project), on the
 //! CC0 maps, the built-in sky (a sun disk ~1e6 bright) and with rotation.
 
-mod common;
+use crate::common;
 
 use dermis::light::{sh, sh_pass};
 use dermis::scene::env::{self as envmap, sky, EnvMap};

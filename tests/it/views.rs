@@ -3,7 +3,7 @@
 //! built-in head (it has a region map), and none is constant: each shows a
 //! quantity that varies over the head.
 
-mod common;
+use crate::common;
 
 use dermis::post::debug::DebugView;
 use dermis::render::sheet::{COLUMNS, TILE};
@@ -66,7 +66,7 @@ fn the_view_list_names_every_screen_view_and_the_papers_intermediates() {
 fn every_view_renders_and_shows_something() {
     let scene = scene();
     common::with_gpu(|ctx| {
-        // The reference is the CPU's (tests/reference_gpu.rs, light::reference).
+        // The reference is the CPU's (tests/it/reference_gpu.rs, light::reference).
         let names = views(ctx, &scene).unwrap();
         for view in names.iter().map(|n| View::named(n)) {
             if view == View::Screen(Screen::Reference) {

@@ -3,7 +3,7 @@
 //! evaluated analytically), and the frame's metering of the lit scan against
 //! the CPU's log-average (post::meter::exposure) and the key it must meet.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::{upload_texture, Readback};

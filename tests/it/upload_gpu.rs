@@ -1,7 +1,7 @@
 //! Static uploads: buffers round-trip, textures get GPU-generated mip levels that
 //! equal the CPU box filter of the level above.
 
-mod common;
+use crate::common;
 
 use ash::vk;
 use dermis::gpu::{Buffer, ImageDesc, MemoryLocation};

@@ -5,7 +5,7 @@
 //! (skin::profile::Profile::transmittance) — within 2 %. And with
 //! `skin.transmission = 0`, or with the light in front, the term adds nothing.
 
-mod common;
+use crate::common;
 
 use dermis::render::{render_scene, RenderOptions, View};
 use dermis::scene::camera::Camera;

@@ -2,7 +2,7 @@
 //! counts exactly its dispatch's invocations, a full-screen draw shades at
 //! least every pixel, with both clocks; without counters nothing is counted.
 
-mod common;
+use crate::common;
 
 use dermis::gpu::ImageDesc;
 use dermis::graph::{Clock, Executor, Graph, LoadOp};

@@ -1,7 +1,7 @@
 //! Per-pass timing: every pass of a frame gets a positive duration and a start,
 //! and the passes fit inside the frame's span, with both clocks.
 
-mod common;
+use crate::common;
 
 use dermis::graph::upload::Readback;
 use dermis::graph::{Clock, Executor, Graph};

@@ -1,7 +1,7 @@
 //! Time against quality: `dermis sweep` as users run it (outputs parse and name
 //! every pass), and the adaptive chain's final image against the full chain's.
 
-mod common;
+use crate::common;
 
 use dermis::render::{render_scene, RenderOptions, View};
 use dermis::scene::file::{load_scene, Chain};

@@ -1,7 +1,7 @@
 //! The command line as users run it, with validation on: outputs, reports, and
 //! clean failures (exit status 2, one line naming the problem) for bad input.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::{Command, Output};

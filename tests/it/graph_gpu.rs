@@ -2,7 +2,7 @@
 //! → graphics pass → readback, checked texel by texel against a CPU computation;
 //! and the foreground gate background executors wait for.
 
-mod common;
+use crate::common;
 
 use ash::vk;
 use dermis::gpu::{Buffer, Context, ImageDesc, MemoryLocation};
