@@ -10,13 +10,14 @@ use std::path::{Path, PathBuf};
 /// its own layer's other modules or anything above.
 const LAYERS: &[&[&str]] = &[
     &["main", "cli"],
+    &["fidelity"],
     &["sweep", "viewer"],
     &["render"],
     &["post", "light"],
     &["skin"],
-    &["frame", "testscene"],
+    &["frame_inputs", "testscene"],
     &["scene", "graph"],
-    &["profile"],
+    &["timing"],
     &["gpu"],
     &["atomic", "cache"],
     &["error", "assets", "text"],

@@ -67,8 +67,8 @@ fn reference_coverage_matches_the_gpu() {
 /// 1 % here (0.5 % in the docs' table) to stay quick.
 #[test]
 fn extracted_lights_beat_sh9_alone_under_a_sunny_map() {
+    use dermis::fidelity::lighting_gap::{run, LightingOptions};
     use dermis::scene::env::EnvSource;
-    use dermis::sweep::lighting::{run, LightingOptions};
     let opts = LightingOptions {
         scene: scene_by_name(None).unwrap(),
         environments: vec![EnvSource::File(dermis::assets::path(
@@ -109,9 +109,9 @@ fn extracted_lights_beat_sh9_alone_under_a_sunny_map() {
 /// The docs' figures (docs/skin.md, "Exact diffusion") come from 1024².
 #[test]
 fn texture_space_diffusion_against_the_exact_reference() {
+    use dermis::fidelity::diffusion_gap::{run, table, DiffusionOptions};
     use dermis::scene::file::Chain;
     use dermis::skin::specular::REGION_NAMES;
-    use dermis::sweep::diffusion::{run, table, DiffusionOptions};
     let mut scene = scene_by_name(None).unwrap();
     scene.render.irradiance_resolution = 256;
     (scene.render.width, scene.render.height) = (48, 60);
@@ -166,8 +166,8 @@ fn texture_space_diffusion_against_the_exact_reference() {
 /// with transmission on and off, while the chain's is not.
 #[test]
 fn the_exact_reference_leaves_out_the_chains_transmitted_light() {
+    use dermis::fidelity::diffusion_gap::{run, DiffusionOptions};
     use dermis::scene::file::Chain;
-    use dermis::sweep::diffusion::{run, DiffusionOptions};
     let read = |transmission: f32| {
         let mut scene = scene_by_name(None).unwrap();
         scene.render.irradiance_resolution = 256;

@@ -174,10 +174,10 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         write_file(&path, &to_json(&path, r)?)?;
     }
     if let Some(path) = args.trace {
-        write_file(&path, &to_json(&path, &dermis::profile::trace::trace(r))?)?;
+        write_file(&path, &to_json(&path, &dermis::timing::trace::trace(r))?)?;
     }
     if let Some(path) = args.csv {
-        write_file(&path, &dermis::profile::csv::csv(r))?;
+        write_file(&path, &dermis::timing::csv::csv(r))?;
     }
     outln!(
         "wrote {} (exposure {:+.2} EV, {})",

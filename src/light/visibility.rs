@@ -11,7 +11,7 @@
 //! in 8-bit steps, once per lighting instead of every frame (issue 24).
 
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex};
+use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
@@ -25,7 +25,7 @@ pub const MAX_RESOLUTION: u32 = 1024;
 /// Three lights per texture (RGB), coverage in alpha, 8 bits each.
 pub const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// Textures the shaders bind (common/lights.glsl SOFT_VISIBILITY): nine lights,
-/// more than frame::MAX_LIGHTS.
+/// more than frame_inputs::MAX_LIGHTS.
 pub const TEXTURES: usize = 3;
 
 pub struct VisibilityPass {

@@ -2,7 +2,7 @@
 //! graph, run it for a number of frames, read the image and the exposure back,
 //! and report per-pass timings; the debug sheet and the occlusion comparison.
 
-mod frame;
+mod frame_graph;
 pub mod output;
 pub mod progress;
 pub mod ruler;
@@ -20,13 +20,13 @@ use crate::light::reference::{render_view_with, ReferenceImage, Settings as Refe
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::profile::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
 use crate::scene::checker;
 use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
-use frame::Frame;
+use crate::timing::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
+use frame_graph::Frame;
 use progress::Progress;
 use sheet::Sheet;
 use std::path::PathBuf;

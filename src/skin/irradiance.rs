@@ -21,7 +21,7 @@
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, Samplers, ShaderVariant};
+use crate::frame_inputs::{FrameInputs, Samplers, ShaderVariant};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle, LoadOp, SimplePass};
 use crate::scene::file::IrradianceShading;

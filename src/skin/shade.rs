@@ -5,7 +5,7 @@
 
 use super::tables::SpecularTables;
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;

@@ -12,7 +12,7 @@ use super::medium_tables::MediumTables;
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant};
+use crate::frame_inputs::{FrameInputs, ShaderVariant};
 use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::upload::upload_texture;
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};

@@ -9,8 +9,6 @@
 //! The albedo is a uniform grey (the scene's albedo map is dropped) and the
 //! skybox off (alpha is the mesh's coverage), so the error is the lighting's.
 
-use super::metric::{relative, RelativeError};
-use super::output::write_side_by_side;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::light::reference::{render_view_with, Settings};
@@ -20,6 +18,8 @@ use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::env::EnvSource;
 use crate::scene::file::{LightsMode, SceneFile};
 use crate::scene::Scene;
+use crate::sweep::metric::{relative, RelativeError};
+use crate::sweep::output::write_side_by_side;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -66,7 +66,7 @@ pub fn run(
         ));
     }
     if let Some(dir) = &opts.out_dir {
-        super::output::create_dir(dir)?;
+        crate::sweep::output::create_dir(dir)?;
     }
     let mut rows = Vec::new();
     for (k, env) in opts.environments.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! JSON and Bencher's Metric Format (BMF) from a run report, and a JUnit XML
 //! summary of a comparison (one test case per pass, failed when regressed).
 
-use super::compare::{Comparison, Verdict};
+use super::regression::{Comparison, Verdict};
 use super::run::RunReport;
 use serde_json::{json, Value};
 
@@ -130,7 +130,7 @@ fn xml(s: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::compare::{compare, CompareOptions, MeasuredFrame, Measurement};
+    use super::super::regression::{compare, CompareOptions, MeasuredFrame, Measurement};
     use super::super::run::tests::report;
     use super::*;
 

@@ -3,7 +3,7 @@
 use super::bound::{bound_by, BoundBy, PassFigures};
 use super::fingerprint::{run_id, timestamp, Fingerprint};
 use super::stats::Stats;
-use super::{FrameReport, PassCounters, PassTime};
+use super::{FrameTiming, PassCounters, PassTime};
 use crate::gpu::DeviceInfo;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -163,7 +163,7 @@ pub struct PassStats {
     /// serve some of it, or it touches less than it declares).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub of_ruler_bandwidth: Option<f64>,
-    /// What bounds the pass (profile::bound), where the rulers ran.
+    /// What bounds the pass (timing::bound), where the rulers ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bound_by: Option<BoundBy>,
     /// What the pass belongs to (e.g. `diffusion`, `ruler`), as it declared.
@@ -265,12 +265,12 @@ pub struct RunReport {
     /// The frame's GPU span over the measured frames.
     pub frame_span: PassStats,
     /// Per-pass medians over the measured frames.
-    pub median: Option<FrameReport>,
+    pub median: Option<FrameTiming>,
     /// Passes only warm-up frames ran: what a render computes once and keeps
     /// (SH projection, prefiltered environment, stretch maps, shadows), from the
     /// first run.
     pub warmup_only: Vec<PassTime>,
-    pub per_frame: Vec<FrameReport>,
+    pub per_frame: Vec<FrameTiming>,
     /// With validation on: the validation layer's messages (warnings and errors)
     /// up to the report, which make the run fail (exit status 4); absent with
     /// validation off.
@@ -283,13 +283,13 @@ pub struct RunReport {
 }
 
 impl RunReport {
-    /// `per_frame` holds every run's frames in order (`FrameReport::run`); the
+    /// `per_frame` holds every run's frames in order (`FrameTiming::run`); the
     /// first `warmup` frames of each run are warm-up, outside the statistics.
     pub fn new(
         device: &DeviceInfo,
         setup: RunSetup,
         (width, height): (u32, u32),
-        mut per_frame: Vec<FrameReport>,
+        mut per_frame: Vec<FrameTiming>,
         warmup: usize,
         memory: MemoryUse,
     ) -> Self {
@@ -302,7 +302,7 @@ impl RunReport {
             };
             per_frame[i].warmup = seen < warmup;
         }
-        let measured: Vec<&FrameReport> = per_frame.iter().filter(|f| !f.warmup).collect();
+        let measured: Vec<&FrameTiming> = per_frame.iter().filter(|f| !f.warmup).collect();
         let mut names: Vec<&str> = Vec::new();
         for p in measured.iter().flat_map(|f| &f.passes) {
             if !names.contains(&p.name.as_str()) {
@@ -358,7 +358,7 @@ impl RunReport {
             .filter(|p| !names.contains(&p.name.as_str()))
             .cloned()
             .collect();
-        let measured_owned: Vec<FrameReport> = measured.into_iter().cloned().collect();
+        let measured_owned: Vec<FrameTiming> = measured.into_iter().cloned().collect();
         let mut fingerprint = Fingerprint::of(device);
         fingerprint.clock = per_frame
             .first()
@@ -390,7 +390,7 @@ impl RunReport {
             memory,
             passes,
             frame_span: PassStats::of("frame (GPU span)", spans),
-            median: FrameReport::median(&measured_owned),
+            median: FrameTiming::median(&measured_owned),
             warmup_only,
             per_frame,
             validation_messages: device.validation.then(crate::gpu::validation_messages),
@@ -399,7 +399,7 @@ impl RunReport {
     }
 
     /// The measured frames, every run's warm-up left out.
-    pub fn measured(&self) -> impl Iterator<Item = &FrameReport> {
+    pub fn measured(&self) -> impl Iterator<Item = &FrameTiming> {
         self.per_frame.iter().filter(|f| !f.warmup)
     }
 
@@ -520,7 +520,7 @@ impl RunReport {
             self.frame_span.time,
         );
         s.push('\n');
-        let measured: Vec<&FrameReport> = self.measured().collect();
+        let measured: Vec<&FrameTiming> = self.measured().collect();
         for (name, v) in [
             (
                 "CPU record",
@@ -632,10 +632,10 @@ pub(super) mod tests {
 
     /// Frames of passes "a" (at 10 ns, lasting `a`) and "b" (right after),
     /// on the host-fence clock, 1000 ns apart.
-    pub fn frames(a: &[f64]) -> Vec<FrameReport> {
+    pub fn frames(a: &[f64]) -> Vec<FrameTiming> {
         a.iter()
             .enumerate()
-            .map(|(i, &a)| FrameReport {
+            .map(|(i, &a)| FrameTiming {
                 frame: i as u64,
                 start_ns: Some(1000.0 * i as f64),
                 passes: vec![

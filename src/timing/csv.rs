@@ -116,7 +116,7 @@ mod tests {
     #[test]
     fn counters_fill_the_last_columns() {
         let mut r = report(&[30.0]);
-        r.per_frame[0].passes[0].counters = Some(crate::profile::PassCounters::from_raw([
+        r.per_frame[0].passes[0].counters = Some(crate::timing::PassCounters::from_raw([
             3, 1, 3, 1, 2, 96, 0,
         ]));
         let text = csv(&r);

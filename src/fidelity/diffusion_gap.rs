@@ -11,8 +11,6 @@
 //! near UV seams, where scattering changes the light by more than 20 %, and over
 //! the face, at texels and through the camera. docs/skin.md, "Exact diffusion".
 
-use super::metric::{relative, RelativeError};
-use super::output::write_side_by_side;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::light::occlusion::Bvh;
@@ -26,6 +24,8 @@ use crate::scene::Scene;
 use crate::skin::reference::{texels, Diffusion, MeshEdges, Texel};
 use crate::skin::specular::REGION_NAMES;
 use crate::skin::SkinSettings;
+use crate::sweep::metric::{relative, RelativeError};
+use crate::sweep::output::write_side_by_side;
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -158,7 +158,7 @@ pub fn run(
         ));
     }
     if let Some(dir) = &opts.out_dir {
-        super::output::create_dir(dir)?;
+        crate::sweep::output::create_dir(dir)?;
     }
     let mut scene = crate::skin::with_medium_albedo(Scene::load(opts.scene.clone())?);
     let skin = SkinSettings::resolve(&scene.file.skin, &scene.file.render)?;

@@ -7,7 +7,7 @@
 use super::ruler;
 use super::view::{Screen, Shown, View};
 use crate::error::{Error, Result};
-use crate::frame::{
+use crate::frame_inputs::{
     upload_env, upload_rgba8, FrameInputs, FrameUniforms, MeshBuffers, Samplers, ShaderVariant,
     HDR_FORMAT, MAX_LIGHTS,
 };

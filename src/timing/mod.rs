@@ -1,16 +1,17 @@
-//! Frame reports: per-pass GPU time and start within the frame, CPU record/submit
-//! time; run reports with statistics over warmed-up frames; trace and CSV output.
+//! Timing reports: per frame, each pass's GPU time and start within the frame
+//! and the CPU record/submit time; run reports with statistics over warmed-up
+//! frames; trace and CSV output.
 
 #[cfg(test)]
 mod aa_study;
 mod bootstrap;
 mod bound;
-pub mod compare;
 mod counters;
 pub mod csv;
 pub mod export;
 pub mod fingerprint;
 mod measurement;
+pub mod regression;
 mod run;
 mod significance;
 mod stats;
@@ -83,7 +84,7 @@ pub struct CpuSpan {
 
 /// What one frame cost.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
-pub struct FrameReport {
+pub struct FrameTiming {
     /// The repetition (`render --runs`) it belongs to, from 0.
     #[serde(default)]
     pub run: u32,
@@ -114,7 +115,7 @@ pub struct FrameReport {
     pub cpu_spans: Vec<CpuSpan>,
 }
 
-impl FrameReport {
+impl FrameTiming {
     /// Sum of the passes' GPU times (≤ `gpu_frame_ns`: barriers and gaps are outside).
     pub fn gpu_pass_sum_ns(&self) -> f64 {
         self.passes.iter().filter_map(|p| p.gpu_ns).sum()
@@ -178,7 +179,7 @@ impl FrameReport {
                 ..Default::default()
             })
             .collect();
-        FrameReport {
+        FrameTiming {
             frame,
             passes,
             gpu_frame_ns,
@@ -201,7 +202,7 @@ impl FrameReport {
 
     /// Per-pass medians (times and starts) over several frames (same pass list),
     /// e.g. after warm-up.
-    pub fn median(frames: &[FrameReport]) -> Option<FrameReport> {
+    pub fn median(frames: &[FrameTiming]) -> Option<FrameTiming> {
         let last = frames.last()?;
         let med = |v: Vec<f64>| stats::median(&v);
         let passes = last
@@ -226,7 +227,7 @@ impl FrameReport {
                 ),
             })
             .collect();
-        Some(FrameReport {
+        Some(FrameTiming {
             frame: last.frame,
             start_ns: None,
             passes,
@@ -285,7 +286,7 @@ mod tests {
         // 36 valid bits: the high garbage bit must be masked away.
         let hi = 1u64 << 40;
         let raw = [hi | 100, hi | 1100, 200, 600, 700, 700];
-        let r = FrameReport::from_timestamps(3, &names, &raw, 36, 2.0);
+        let r = FrameTiming::from_timestamps(3, &names, &raw, 36, 2.0);
         assert_eq!(r.gpu_frame_ns, Some(2000.0));
         assert_eq!(r.pass_ns("a"), Some(800.0));
         assert_eq!(r.pass_ns("b"), None);
@@ -298,16 +299,16 @@ mod tests {
     #[test]
     fn a_pass_before_the_frame_begin_has_no_start() {
         let names = vec!["a".to_string()];
-        let r = FrameReport::from_timestamps(0, &names, &[500, 900, 500, 600], 64, 1.0);
+        let r = FrameTiming::from_timestamps(0, &names, &[500, 900, 500, 600], 64, 1.0);
         assert_eq!(r.pass_start_ns("a"), Some(0.0));
-        let r = FrameReport::from_timestamps(0, &names, &[500, 900, 400, 600], 64, 1.0);
+        let r = FrameTiming::from_timestamps(0, &names, &[500, 900, 400, 600], 64, 1.0);
         assert_eq!(r.pass_start_ns("a"), None);
         assert_eq!(r.pass_ns("a"), Some(200.0));
     }
 
     #[test]
     fn median_per_pass() {
-        let f = |v: f64| FrameReport {
+        let f = |v: f64| FrameTiming {
             passes: vec![PassTime {
                 name: "p".into(),
                 gpu_ns: Some(v),
@@ -317,7 +318,7 @@ mod tests {
             gpu_frame_ns: Some(v * 2.0),
             ..Default::default()
         };
-        let m = FrameReport::median(&[f(5.0), f(1.0), f(3.0), f(100.0)]).unwrap();
+        let m = FrameTiming::median(&[f(5.0), f(1.0), f(3.0), f(100.0)]).unwrap();
         assert_eq!(m.pass_ns("p"), Some(4.0));
         assert_eq!(m.pass_start_ns("p"), Some(5.0));
         assert_eq!(m.gpu_frame_ns, Some(8.0));

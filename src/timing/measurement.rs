@@ -150,8 +150,8 @@ impl Measurement {
 }
 
 /// Each pass's time in a frame; of two passes of one name the first, as the
-/// report's statistics take it (FrameReport::pass_ns).
-fn first_of_each(f: &super::FrameReport) -> BTreeMap<String, f64> {
+/// report's statistics take it (FrameTiming::pass_ns).
+fn first_of_each(f: &super::FrameTiming) -> BTreeMap<String, f64> {
     let mut out = BTreeMap::new();
     for p in &f.passes {
         if let Some(ns) = p.gpu_ns.filter(|v| v.is_finite()) {

@@ -248,7 +248,7 @@ mod tests {
     #[test]
     fn counters_are_pass_arguments_and_counter_tracks() {
         let mut r = report(&[30.0]);
-        r.per_frame[0].passes[0].counters = Some(crate::profile::PassCounters {
+        r.per_frame[0].passes[0].counters = Some(crate::timing::PassCounters {
             fragment_invocations: 96,
             compute_invocations: 7,
             ..Default::default()
@@ -282,13 +282,13 @@ mod tests {
         f.start_ns = Some(1000.0);
         f.host_start_ns = Some(5000.0);
         f.cpu_spans = vec![
-            crate::profile::CpuSpan {
+            crate::timing::CpuSpan {
                 what: "record".into(),
                 start_ns: 4000.0,
                 dur_ns: 500.0,
                 ..Default::default()
             },
-            crate::profile::CpuSpan {
+            crate::timing::CpuSpan {
                 what: "wait".into(),
                 start_ns: 4600.0,
                 dur_ns: 500.0,

@@ -3,7 +3,7 @@
 //! side, and 20 A/A pairs at 4 and at 10 runs a side give no false alarm
 //! (docs/performance.md, "Comparing runs").
 
-use super::compare::{
+use super::regression::{
     compare, table, CompareOptions, Comparison, MeasuredFrame, Measurement, PassChange, Test,
     Verdict, FRAME_ROW,
 };

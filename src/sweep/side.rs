@@ -4,7 +4,7 @@
 
 use super::{Point, Sweep};
 use crate::error::{Error, Result};
-use crate::profile::compare::{MeasuredFrame, Measurement};
+use crate::timing::regression::{MeasuredFrame, Measurement};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
