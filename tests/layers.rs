@@ -1,4 +1,4 @@
-//! The layering of `src/` (docs/architecture.md): each top-level module imports
+//! The layering of `src/` (docs/design/architecture.md): each top-level module imports
 //! only modules of lower layers, and the files inside a module import each other
 //! without circles. Reads every `crate::…` and `super::…` path in the code
 //! (comments excluded), so a future back-import fails here.

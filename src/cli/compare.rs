@@ -19,7 +19,7 @@ pub struct DecideArgs {
     #[arg(long, value_enum, default_value = "auto")]
     unit: regression::Unit,
     /// Relative change below which a pass is not reported changed (0.06 = 6 %:
-    /// the A/A noise measured in docs/performance.md).
+    /// the A/A noise measured in docs/guide/compare-in-ci.md).
     #[arg(long, default_value_t = regression::DEFAULT_NOISE_THRESHOLD)]
     noise_threshold: f64,
     /// Family-wise significance level (Holm-corrected over the passes).

@@ -72,13 +72,13 @@ pub struct RenderArgs {
     /// Also time three ruler passes at the irradiance resolution (an RGBA16F
     /// copy, `ruler_copy`, a read, `ruler_read`, and one workgroup of the read,
     /// `ruler_empty`) and report every pass's ns/texel
-    /// as a multiple of the copy's (docs/performance.md).
+    /// as a multiple of the copy's (docs/guide/measure.md).
     #[arg(long)]
     ruler: bool,
     /// Count every pass's work with pipeline statistics queries (vertices,
     /// primitives, vertex, fragment and compute invocations) into the timing
     /// table, report, CSV and trace; needs the device's
-    /// pipelineStatisticsQuery feature (docs/performance.md, "Work counters").
+    /// pipelineStatisticsQuery feature (docs/design/pass-analysis.md, "Work counters").
     #[arg(long)]
     counters: bool,
 }

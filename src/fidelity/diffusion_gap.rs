@@ -9,7 +9,7 @@
 //! transmitted light the final pass adds). The relative error of luminance
 //! (sweep::metric::relative) is reported per face region of the region map,
 //! near UV seams, where scattering changes the light by more than 20 %, and over
-//! the face, at texels and through the camera. docs/skin.md, "Exact diffusion".
+//! the face, at texels and through the camera. docs/records/2026-11-26-exact-diffusion.md, "Exact diffusion".
 
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -425,7 +425,7 @@ impl Level {
 /// The irradiance the reference convolves: the chain's, less the sky's light
 /// through thin skin (light::transmission), which the chain adds to its
 /// irradiance as its stand-in for the far side of a thin part and which the
-/// reference carries itself, by its chords through the skin (docs/skin.md,
+/// reference carries itself, by its chords through the skin (docs/records/2026-11-26-exact-diffusion.md,
 /// "Exact diffusion"). Without transmission, the chain's own irradiance.
 fn entering_irradiance(ctx: &Arc<Context>, scene: &Scene, irradiance: &Level) -> Result<Level> {
     if scene.file.skin.transmission <= 0.0 {
@@ -662,7 +662,7 @@ fn region_ids(scene: &Scene, points: impl Iterator<Item = (Vec2, Vec3)>) -> Vec<
 /// The face region of a point `d` mm from the nose tip (the mesh's most +z
 /// point) of a head looking along +z, y up: boxes about the tip sized for an
 /// adult face (nasal bridge ~50 mm, tip to mouth ~35 mm, ears ~75 mm to the
-/// side), checked by eye on the scan (docs/skin.md shows the masks).
+/// side), checked by eye on the scan (docs/design/skin.md shows the masks).
 pub fn landmark_region(d: Vec3) -> usize {
     let (x, y, z) = (d.x.abs(), d.y, d.z);
     let within = |v: f32, lo: f32, hi: f32| (lo..=hi).contains(&v);

@@ -65,7 +65,7 @@ pub struct RenderOptions {
 
 /// The default pre-roll on GPUs. An NVIDIA H200 left idle between a sweep's
 /// points measured the next point at 345–750 MHz instead of 1980: its raster
-/// passes up to 5.6× slower (docs/performance.md, "On a real GPU").
+/// passes up to 5.6× slower (docs/records/2026-11-26-h200.md).
 pub const PREROLL_GPU_MS: u32 = 1000;
 
 impl RenderOptions {

@@ -1,7 +1,7 @@
 //! The verdict rule on synthetic interleaved measurements with this
 //! machine's noise: a pass made 3× slower is called regressed from 4 runs a
 //! side, and 20 A/A pairs at 4 and at 10 runs a side give no false alarm
-//! (docs/performance.md, "Comparing runs").
+//! (docs/guide/compare-in-ci.md, "Comparing runs").
 
 use super::regression::{
     compare, table, CompareOptions, Comparison, MeasuredFrame, Measurement, PassChange, Test,
@@ -54,7 +54,7 @@ const FRAME: [(&str, f64); 15] = [
 ];
 
 /// One side of an interleaved measurement of [`FRAME`] with the noise of
-/// this 2-core machine under load (docs/performance.md, "Comparing runs":
+/// this 2-core machine under load (docs/guide/compare-in-ci.md, "Comparing runs":
 /// runs move ±10 % quiet to ±25 % busy; a pass's runs scatter ±20–30 %):
 /// per run a machine load shared by every pass and the ruler (log-normal,
 /// σ 0.12) that one run in ten meets busier still (×1.4); per run and pass

@@ -1,4 +1,4 @@
-//! What bounds a pass (docs/pass-analysis.md): memory, shading, the fixed-
+//! What bounds a pass (docs/design/pass-analysis.md): memory, shading, the fixed-
 //! function units or per-pass overhead, from what a report measured — its
 //! time against an empty dispatch's, its nominal bandwidth against the copy
 //! ruler's, and its work counters — in the roofline's spirit (Williams,

@@ -21,7 +21,7 @@ use serde::Serialize;
 /// The default noise threshold: the relative change below which a difference
 /// is not reported — the median |change| of passes of ≥ 5 ms between two
 /// interleaved sets of 10 identical runs on lavapipe, over 20 such pairs
-/// (docs/performance.md, "Comparing runs": 5.9 %).
+/// (docs/guide/compare-in-ci.md, "Comparing runs": 5.9 %).
 pub const DEFAULT_NOISE_THRESHOLD: f64 = 0.06;
 /// Significance level of the Holm-corrected test (criterion.rs's default).
 pub const DEFAULT_SIGNIFICANCE: f64 = 0.05;

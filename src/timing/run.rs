@@ -579,7 +579,10 @@ impl RunReport {
             })
             .collect();
         if !bound.is_empty() {
-            s += &format!("bound by (docs/pass-analysis.md):\n{}", bound.concat());
+            s += &format!(
+                "bound by (docs/design/pass-analysis.md):\n{}",
+                bound.concat()
+            );
         }
         let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
         s += &format!(

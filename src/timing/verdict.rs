@@ -1,4 +1,4 @@
-//! A pass's verdict from its two samples (docs/performance.md, "Comparing
+//! A pass's verdict from its two samples (docs/guide/compare-in-ci.md, "Comparing
 //! runs"): the test and interval that fit the samples, then criterion.rs's rule
 //! — a change counts only when it is significant after Holm's correction
 //! **and** its whole interval lies beyond the noise threshold — with Chromium

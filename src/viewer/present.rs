@@ -154,7 +154,7 @@ impl Presenter {
         let compiled = self.executor.compile(g)?;
         // No pass of the render thread's is submitted between this frame's
         // submission and its present: on lavapipe, without this, a window frame
-        // also waited behind the passes submitted meanwhile (docs/viewer.md).
+        // also waited behind the passes submitted meanwhile (docs/design/viewer.md).
         let ctx = self.ctx.clone();
         let foreground = ctx.foreground();
         let report = self.executor.submit_synced(
