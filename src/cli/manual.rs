@@ -52,7 +52,7 @@ fn section(command: &Command, path: &str, page: &mut String) {
     page.push_str(&format!("```text\n{usage}\n```\n\n"));
     let args: Vec<&Arg> = command
         .get_arguments()
-        .filter(|a| !a.is_hide_set() && !a.is_global_set() || path == "dermis")
+        .filter(|a| !a.is_hide_set() && (path == "dermis" || !a.is_global_set()))
         .filter(|a| !matches!(a.get_action(), ArgAction::Help | ArgAction::Version))
         .collect();
     if !args.is_empty() {
