@@ -74,7 +74,8 @@ enum Command {
     /// (`--view direct`, grey albedo) with the paper's SH9 alone and with the
     /// bright sources extracted as shadowed lights, each against the CPU
     /// reference (`--view reference`); prints the mean, median and 90th
-    /// percentile of the per-pixel relative error over the mesh (docs/design/lighting.md).
+    /// percentile of the per-pixel relative error over the mesh
+    /// (docs/records/2026-11-25-sh9-against-reference.md).
     ///
     /// --env repeats, one comparison each (default: the scene's own).
     #[command(after_help = AFTER_HELP)]
