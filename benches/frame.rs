@@ -9,7 +9,7 @@
 //! sun in the SH or taken out as a soft-shadowed light, side by side) and
 //! `DERMIS_BENCH_KERNEL` (`deon7` or `accurate`) tune it. Writes
 //! `target/bench-frame.json` (one run report per run, each with its setup) for
-//! docs/performance.md.
+//! docs/design/cost-model.md.
 
 use dermis::gpu::{Context, ContextOptions};
 use dermis::render::{render_scene, RenderOptions};

@@ -1,5 +1,5 @@
 #version 460
-// The copy ruler (docs/performance.md): one RGBA16F texel read and one written per
+// The copy ruler (docs/guide/measure.md): one RGBA16F texel read and one written per
 // invocation, at the blur chain's resolution and format, workgroups as blur.comp's.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D src;

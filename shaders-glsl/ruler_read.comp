@@ -1,5 +1,5 @@
 #version 460
-// The read ruler (docs/performance.md): one RGBA16F texel read per invocation and
+// The read ruler (docs/guide/measure.md): one RGBA16F texel read per invocation and
 // nothing written (coverage is never negative), so the reads cannot be dropped.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D src;

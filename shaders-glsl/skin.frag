@@ -5,7 +5,7 @@
 // Plus the KS specular (the paper's eq. 1) of the explicit lights and of the
 // environment (split sum: ρs·A(N·V, m) × the KS-prefiltered environment).
 // With TRANSMISSION, the light of shadowed lights behind the skin transmitted
-// through it adds to the diffuse (docs/skin.md, "Transmission"), from the
+// through it adds to the diffuse (docs/records/2026-11-26-transmission.md, "Transmission"), from the
 // texture translucent.frag drew once per lighting for the side shaded.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -124,7 +124,7 @@ void main() {
     // leaves later: the exit factor 1 − ρs·A(N·V) renormalised by its
     // hemispherical mean 1 − ρs·Ā(m), so that light entering leaves whole and a
     // white surface under a white sky reflects 1 (Kelemen & Szirmay-Kalos
-    // 2001's coupled diffuse term; docs/skin.md, "White furnace").
+    // 2001's coupled diffuse term; docs/design/skin.md, "White furnace").
     float exit = (1.0 - reflected) / max(1.0 - params.x * albedos.y, 1e-3);
     // The transmitted light enters with the pre-scatter albedo, as the
     // irradiance does (x's own albedo for the far side's).
@@ -143,7 +143,7 @@ void main() {
     }
     // The environment's share, occluded by what lies in the lobe about the
     // mirror direction (light/occlusion/lobe.rs; 1 without occlusion), not by
-    // the diffuse's cosine-weighted open sky (docs/skin.md).
+    // the diffuse's cosine-weighted open sky (docs/design/skin.md).
     vec3 r = reflect(-v, n);
     float visibility = OCCLUSION ? lobe_visibility(v_s012, v_s345, v_s678, r, n, params.y) : 1.0;
     // The blocked share sees the head's own skin, not the sky: taken as lit

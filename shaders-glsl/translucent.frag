@@ -1,6 +1,6 @@
 #version 460
 // The light of the shadowed lights transmitted through thin skin, in texture
-// space, once per lighting (skin/translucent.rs; docs/skin.md, "Transmission"):
+// space, once per lighting (skin/translucent.rs; docs/records/2026-11-26-transmission.md, "Transmission"):
 // translucent shadow maps (d'Eon & Luebke §14.5.3; Jimenez et al. 2010). For
 // each light the surface faces away from (dot(ng, l) < 0, so a lit face, whose
 // thickness is ≈ 0, is not lit twice) and whose light enters by a surface

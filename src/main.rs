@@ -3,8 +3,8 @@
 
 mod cli;
 
-use clap::{Parser, Subcommand};
-use cli::{compare, inspect, medium, reference, render, sweep, view, AFTER_HELP};
+use clap::{CommandFactory, Parser, Subcommand};
+use cli::{compare, inspect, manual, medium, reference, render, sweep, view, AFTER_HELP};
 use dermis::gpu::ContextOptions;
 use std::process::ExitCode;
 
@@ -43,13 +43,13 @@ enum Command {
     ///
     /// Per light: its direction (world, after --rotate), elevation and azimuth,
     /// solid angle, angular radius, power (RGB irradiance at normal incidence) and
-    /// share of the map's energy; then the residual's share (docs/lighting.md).
+    /// share of the map's energy; then the residual's share (docs/design/lighting.md).
     /// Shares are fractions in --json. Runs on the CPU.
     #[command(after_help = AFTER_HELP)]
     Lights(inspect::LightsArgs),
     /// Print the scene's skin medium (--medium, `[skin.medium]`): its
     /// coefficients, albedo, the six Gaussians fitted to its R(r) with their
-    /// error, and its light through slabs (docs/media.md). Runs on the CPU;
+    /// error, and its light through slabs (docs/design/media.md). Runs on the CPU;
     /// the tables are cached.
     #[command(after_help = AFTER_HELP)]
     Medium(medium::MediumArgs),
@@ -65,7 +65,7 @@ enum Command {
     /// 99th percentile, PSNR). Writes points.jsonl, sweep.csv, sweep.json,
     /// time_vs_error.{svg,png} and passes.{svg,png} into --out-dir; with --shard,
     /// only this shard's points-shard-I-of-N.jsonl, for `dermis sweep merge`
-    /// (docs/performance.md, docs/recipes/).
+    /// (docs/guide/sweep.md, docs/recipes/).
     ///
     /// The scene's skybox is turned off: the face mask is the image's alpha.
     #[command(after_help = AFTER_HELP, args_conflicts_with_subcommands = true)]
@@ -74,7 +74,8 @@ enum Command {
     /// (`--view direct`, grey albedo) with the paper's SH9 alone and with the
     /// bright sources extracted as shadowed lights, each against the CPU
     /// reference (`--view reference`); prints the mean, median and 90th
-    /// percentile of the per-pixel relative error over the mesh (docs/lighting.md).
+    /// percentile of the per-pixel relative error over the mesh
+    /// (docs/records/2026-11-25-sh9-against-reference.md).
     ///
     /// --env repeats, one comparison each (default: the scene's own).
     #[command(after_help = AFTER_HELP)]
@@ -93,7 +94,7 @@ enum Command {
     /// Compare two measurements pass by pass: the change of each pass's median
     /// (in ruler units where both sides ran --ruler, else ms), a bootstrap 95 %
     /// interval, a Mann-Whitney U p-value Holm-corrected over the passes, and a
-    /// verdict: regressed / improved / unchanged / inconclusive (docs/performance.md,
+    /// verdict: regressed / improved / unchanged / inconclusive (docs/guide/compare-in-ci.md,
     /// "Comparing runs").
     #[command(after_help = AFTER_HELP)]
     Compare(compare::CompareArgs),
@@ -112,6 +113,9 @@ enum Command {
     /// Render a scene to an image (by default the scanned head, assets/default.toml).
     #[command(after_help = AFTER_HELP)]
     Render(render::RenderArgs),
+    /// Print the command-line reference page (docs/reference/cli.md).
+    #[command(hide = true)]
+    CliReference(manual::ManualArgs),
 }
 
 fn main() -> ExitCode {
@@ -160,6 +164,7 @@ fn run(cli: Cli) -> dermis::Result<ExitCode> {
         Command::Export(args) => compare::export(args),
         Command::ReportSchema => compare::report_schema(),
         Command::Render(args) => render::render(args, &context),
+        Command::CliReference(args) => manual::manual(args, Cli::command()),
     };
     done.map(|()| ExitCode::SUCCESS)
 }

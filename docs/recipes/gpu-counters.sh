@@ -1,5 +1,5 @@
 #!/bin/bash
-# The GPU figures of docs/pass-analysis.md: the default frame's work counters
+# The GPU figures of docs/design/pass-analysis.md: the default frame's work counters
 # and bound-by verdicts at 4096² and 1024² (the irradiance pass in both
 # formulations), the cost of --counters (interleaved, off against on), and
 # the frame with counters off against a base build. Run from the repository

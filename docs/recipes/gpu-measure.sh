@@ -1,5 +1,5 @@
 #!/bin/bash
-# The real-GPU measurements of docs/performance.md ("On a real GPU"): per-pass
+# The real-GPU measurements of docs/design/cost-model.md ("On a real GPU"): per-pass
 # GPU timestamps of the default scene and the lit close-up, an interleaved
 # comparison with a base build, the irradiance pass's raster and compute
 # formulations side by side, and both sweeps. Run from the repository root:
@@ -42,7 +42,7 @@ if [ -n "${BASE:-}" ]; then
     done
 fi
 # The irradiance pass's two formulations side by side (`auto` runs compute on
-# a GPU; docs/performance.md, "The irradiance pass in compute").
+# a GPU; docs/records/2026-11-27-compute-irradiance.md, "The irradiance pass in compute").
 for res in 1024 4096; do
     step 300 "$DERMIS" interleave --runs "$RUNS" --frames "$FRAMES" --allow-setup-change \
         --base-args "--irradiance-res $res --irradiance-shading raster" \

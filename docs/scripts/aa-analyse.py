@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A/A noise and power of `dermis compare` (docs/performance.md, "Comparing runs").
+"""A/A noise and power of `dermis compare` (docs/guide/compare-in-ci.md, "Comparing runs").
 
 Reads the pairs aa-interleave.sh wrote (pairK/base/run-*.json and
 pairK/new/run-*.json: the same render, RUNS processes a side, interleaved) and

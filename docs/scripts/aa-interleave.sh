@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A/A noise of `dermis compare` (docs/performance.md, "Comparing runs"): PAIRS
+# A/A noise of `dermis compare` (docs/guide/compare-in-ci.md, "Comparing runs"): PAIRS
 # interleaved comparisons of a render with itself, RUNS processes a side
 # (dermis interleave), each kept in OUT_DIR/pairK/{base,new}/ for
 # aa-analyse.py. Resumable: finished pairs are skipped. Usage:

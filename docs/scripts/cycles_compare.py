@@ -15,7 +15,7 @@ pixel's |dermis - ref| / max(ref, 0.1 x the mesh's mean), dermis's metric
 (sweep::metric::relative); the level, sum(dermis)/sum(ref) of luminance; the
 bias per channel, sum(dermis - ref)/sum(ref). Groups are face regions by the
 pixel's surface point (the Position pass) about the nose tip: the boxes of
-dermis's sweep::diffusion::landmark_region, plus a few of this script's own
+dermis's fidelity::diffusion_gap::landmark_region, plus a few of this script's own
 (nostrils, lip line, neck sides, chest), checked by eye on --regions-png.
 """
 
@@ -30,7 +30,7 @@ import numpy as np
 import OpenEXR
 
 MM_PER_UNIT = 50.3
-# The scan's most +z vertex (dermis world mm, +Y up), as sweep::diffusion's
+# The scan's most +z vertex (dermis world mm, +Y up), as fidelity::diffusion_gap's
 # region_ids takes it: bpy's import of LeePerrySmith.glb, x 50.3 mm.
 NOSE_TIP_MM = np.array([-4.42, 55.20, 130.30])
 LANDMARK_NAMES = [
@@ -48,7 +48,7 @@ LANDMARK_NAMES = [
 
 
 def landmark_region(d):
-    """sweep::diffusion::landmark_region, vectorised: d (N, 3) mm from the tip."""
+    """fidelity::diffusion_gap::landmark_region, vectorised: d (N, 3) mm from the tip."""
     x, y, z = np.abs(d[:, 0]), d[:, 1], d[:, 2]
 
     def within(v, lo, hi):

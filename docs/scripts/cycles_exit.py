@@ -1,4 +1,4 @@
-"""Cycles' subsurface exit against a Lambertian one, per pixel (docs/skin.md,
+"""Cycles' subsurface exit against a Lambertian one, per pixel (docs/records/2026-11-26-path-tracer-cycles.md,
 "The colour where nothing bounces: the reference's exit").
 
     PY=/work/bpy-venv/bin/python; S=docs/scripts/cycles_reference.py

@@ -1,6 +1,6 @@
 """A path-traced reference of dermis's default scene in Blender's Cycles (>= 4.0).
 
-Run with the Python of a venv that holds the `bpy` wheel (docs/skin.md,
+Run with the Python of a venv that holds the `bpy` wheel (docs/records/2026-11-26-path-tracer-cycles.md,
 "Against a path tracer"):
 
     python3 -m venv /work/bpy-venv && /work/bpy-venv/bin/pip install bpy==4.2.0 numpy OpenEXR
@@ -36,7 +36,7 @@ MM_PER_UNIT = 50.3  # assets/default.toml
 SKIN1_MFP_MM = (3.67, 1.37, 0.68)
 SKIN_IOR = 1.4  # d'Eon & Luebke, GPU Gems 3 §14.3 (F0 = 0.028)
 
-# dermis's specular (src/skin/specular.rs, docs/skin.md "Calibration"): rho_s =
+# dermis's specular (src/skin/specular.rs, docs/records/2026-11-22-specular-on-the-gpu.md "Calibration"): rho_s =
 # 0.18 (1 + (0.16/0.18) t), t = min(s / (2 s_mean), 1), s the specular map's red
 # channel (linear) and s_mean = 0.244 its area-weighted mean over the scan; the KS
 # lobe at rho_s is rho_s/0.35 of a dielectric of F0 0.028 (0.736 at rho_s =
@@ -105,7 +105,7 @@ def parse_args(argv):
         help="black: base colour 0 and no subsurface, so the image is the specular "
         "layer alone; black-to-camera: base colour 0 for camera rays only, so the "
         "image is the specular layer alone, reflecting the skin as it is lit "
-        "(docs/skin.md, \"The specular against the reference's\")",
+        "(docs/records/2026-11-26-path-tracer-cycles.md, \"The specular against the reference's\")",
     )
     p.add_argument(
         "--occlusion",
@@ -132,14 +132,14 @@ def parse_args(argv):
         type=float,
         default=100.0,
         help="with --slab: its thickness in mm (with --sun 0,1,0:E and --sky 0, the "
-        "light it transmits; docs/skin.md, \"Transmission against the walk\")",
+        "light it transmits; docs/design/skin.md, \"Transmission against the walk\")",
     )
     p.add_argument(
         "--slab-edge",
         action="store_true",
         help="with --slab: a half plane 3 mm above it, hidden from the camera, "
         "shadows x < 0, and the camera sees 24 mm across the edge (the light "
-        "the walk carries into the shadow; docs/skin.md)",
+        "the walk carries into the shadow; docs/design/skin.md)",
     )
     p.add_argument(
         "--slab-mu",
@@ -316,7 +316,7 @@ def skin_material(args):
     # Cycles' kernel/closure/bssrdf.h, bssrdf_setup_radius: RANDOM_WALK_SKIN
     # scales the radius so that it is diffusion theory's 1/sigma_tr (Jensen's
     # diffuse mean free path) at the IOR, and refracts on entry; RANDOM_WALK
-    # scales it by 1/(4 pi) and exits index-matched (docs/skin.md).
+    # scales it by 1/(4 pi) and exits index-matched (docs/design/skin.md).
     bsdf.subsurface_method = "RANDOM_WALK_SKIN" if args.sss_method == "skin" else "RANDOM_WALK"
     if args.base == "black":
         # The specular layer alone: nothing under it reflects.
@@ -395,7 +395,7 @@ def world(args):
         tex.interpolation = "Closest"  # dermis's reference: piecewise constant
         # Cycles looks up u = 0.5 - atan2(y, x)/2pi (Blender axes), so u = 0.5
         # looks along +X; dermis's u = 0.5 looks along its -Z, Blender's +Y
-        # (docs/lighting.md). Turning the direction by -90° about Z first gives
+        # (docs/design/lighting.md). Turning the direction by -90° about Z first gives
         # dermis's u.
         coord = nodes.new("ShaderNodeTexCoord")
         mapping = nodes.new("ShaderNodeMapping")

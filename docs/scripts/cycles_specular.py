@@ -1,5 +1,5 @@
 """dermis's specular against the Cycles reference's specular layer, per region
-(docs/skin.md, "The specular against the reference's").
+(docs/records/2026-11-26-path-tracer-cycles.md, "The specular against the reference's").
 
     /work/bpy-venv/bin/python docs/scripts/cycles_specular.py \
         --dermis spec.exr --dermis-open spec_open.exr --normals normals.exr \

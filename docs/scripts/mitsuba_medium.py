@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The scanned head as a homogeneous medium in a volumetric path tracer
-(Mitsuba 3): the truth dermis's `[skin.medium]` is held to (docs/media.md).
+(Mitsuba 3): the truth dermis's `[skin.medium]` is held to (docs/design/media.md).
 
 The mesh (assets/head/lee-perry-smith/LeePerrySmith.glb, 50.3 mm per unit, in
 dermis's world: mm, +Y up) is the boundary of one homogeneous medium: a rough

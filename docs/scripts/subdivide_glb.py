@@ -1,7 +1,7 @@
 """Split every triangle of a one-primitive GLB into four at its edges' midpoints,
 LEVELS times: the same surface (positions, UVs linear; normals interpolated and
 renormalised, as the rasteriser does), more vertices, so the per-vertex
-transfer is sampled more densely (docs/skin.md, "What the numbers point to").
+transfer is sampled more densely (docs/records/2026-11-26-path-tracer-cycles.md, "What the numbers point to").
 
     python3 docs/scripts/subdivide_glb.py IN.glb OUT.glb LEVELS   # numpy
 """

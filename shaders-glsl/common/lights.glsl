@@ -296,7 +296,7 @@ float stored_hard_visibility(int i) {
 // size, here none, not the map's texel). Taps d texels apart have variance
 // 2d²/3 plus a bilinear tap's 1/6; the footprint's box of f texels, f²/12:
 // d = √(f²/8 − ¼), from 0 (one bilinear comparison's worth) to 1 texel (the
-// reach the acne offsets allow for). docs/lighting.md.
+// reach the acne offsets allow for). docs/design/lighting.md.
 float hard_shadow(int i, vec3 x, vec3 ng, vec3 l, float dist) {
     ShadowMap m = shadow_map(i, x, 0.0);
     vec3 s = shadow_point(m, frame.light_vec[i].w > 0.5, x, ng, l, dist).xyz;

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use dermis::profile::compare::{self, Comparison, Measurement};
-use dermis::sweep::compare::{self as input, Side};
+use dermis::sweep::side::{self as input, Side};
+use dermis::timing::regression::{self, Comparison, Measurement};
 
 use super::{check_distinct, check_out_dir, check_output, read_text, to_json, write_file};
 
@@ -17,13 +17,13 @@ pub struct DecideArgs {
     /// its frame or run: a busier machine cancels), `ms`, or `auto` (ruler units
     /// where they scatter less between samples than ms).
     #[arg(long, value_enum, default_value = "auto")]
-    unit: compare::Unit,
+    unit: regression::Unit,
     /// Relative change below which a pass is not reported changed (0.06 = 6 %:
-    /// the A/A noise measured in docs/performance.md).
-    #[arg(long, default_value_t = compare::DEFAULT_NOISE_THRESHOLD)]
+    /// the A/A noise measured in docs/guide/compare-in-ci.md).
+    #[arg(long, default_value_t = regression::DEFAULT_NOISE_THRESHOLD)]
     noise_threshold: f64,
     /// Family-wise significance level (Holm-corrected over the passes).
-    #[arg(long, default_value_t = compare::DEFAULT_SIGNIFICANCE)]
+    #[arg(long, default_value_t = regression::DEFAULT_SIGNIFICANCE)]
     significance: f64,
     /// Compare even where the work differs (scene, mesh, view, sizes).
     #[arg(long)]
@@ -183,17 +183,17 @@ pub fn export(args: ExportArgs) -> dermis::Result<()> {
     let source = args.report.display().to_string();
     let value: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| dermis::Error::Input(format!("{source}: not JSON: {e}")))?;
-    dermis::profile::compare::check_report_schema(&value, &source)?;
-    let r: dermis::profile::RunReport = serde_json::from_value(value)
+    dermis::timing::regression::check_report_schema(&value, &source)?;
+    let r: dermis::timing::RunReport = serde_json::from_value(value)
         .map_err(|e| dermis::Error::Input(format!("{source}: not a dermis run report: {e}")))?;
     if let Some(path) = args.github_benchmark {
-        let v = dermis::profile::export::github_benchmark(&r);
+        let v = dermis::timing::export::github_benchmark(&r);
         write_file(&path, &to_json(&path, &v)?)?;
     }
     if let Some(path) = args.bencher {
         write_file(
             &path,
-            &to_json(&path, &dermis::profile::export::bencher(&r))?,
+            &to_json(&path, &dermis::timing::export::bencher(&r))?,
         )?;
     }
     Ok(())
@@ -201,7 +201,7 @@ pub fn export(args: ExportArgs) -> dermis::Result<()> {
 
 /// `dermis report-schema`.
 pub fn report_schema() -> dermis::Result<()> {
-    let schema = schemars::schema_for!(dermis::profile::RunReport);
+    let schema = schemars::schema_for!(dermis::timing::RunReport);
     outln!("{}", to_json(Path::new("stdout"), &schema)?);
     Ok(())
 }
@@ -214,7 +214,7 @@ fn report_comparison(
     decide: &DecideArgs,
     warnings: Vec<String>,
 ) -> dermis::Result<ExitCode> {
-    let opts = compare::CompareOptions {
+    let opts = regression::CompareOptions {
         unit: decide.unit,
         noise_threshold: decide.noise_threshold,
         significance: decide.significance,
@@ -229,7 +229,7 @@ fn report_comparison(
     }
     let mut results: Vec<(String, Comparison)> = Vec::new();
     for (label, base, new) in pairs {
-        results.push((label.clone(), compare::compare(base, new, &opts)?));
+        results.push((label.clone(), regression::compare(base, new, &opts)?));
     }
     if let [(label, c)] = results.as_mut_slice() {
         if label.is_empty() {
@@ -258,12 +258,12 @@ fn report_comparison(
             if !label.is_empty() {
                 outln!("\n== point {label}");
             }
-            out!("{}", compare::table(c));
+            out!("{}", regression::table(c));
         }
     }
     let comparisons: Vec<&Comparison> = results.iter().map(|(_, c)| c).collect();
     if let Some(path) = &decide.junit {
-        write_file(path, &dermis::profile::export::junit(&comparisons))?;
+        write_file(path, &dermis::timing::export::junit(&comparisons))?;
     }
     let regressed = comparisons.iter().any(|c| c.regressed());
     Ok(if decide.fail_on_regression && regressed {

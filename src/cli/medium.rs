@@ -1,6 +1,6 @@
 //! `dermis medium`: what the scene's skin medium gives — its coefficients, its
 //! albedo, the chain's six Gaussians fitted to its R(r) and their error, and
-//! its light through a slab by thickness — on the CPU (docs/media.md).
+//! its light through a slab by thickness — on the CPU (docs/design/media.md).
 
 use clap::Args;
 use dermis::scene::{Overrides, SceneArg};

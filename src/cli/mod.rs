@@ -15,6 +15,7 @@ macro_rules! out {
 
 pub mod compare;
 pub mod inspect;
+pub mod manual;
 pub mod medium;
 pub mod reference;
 pub mod render;

@@ -3,10 +3,10 @@
 use std::path::{Path, PathBuf};
 
 use clap::{ArgAction, ArgMatches, Args, Command, FromArgMatches};
+use dermis::fidelity::lighting_gap;
 use dermis::gpu::{Context, ContextOptions};
 use dermis::scene::env::EnvSource;
 use dermis::scene::{Overrides, SceneArg};
-use dermis::sweep::lighting;
 
 use super::to_json;
 
@@ -105,7 +105,7 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
             "--target-error {target_error}: must be in (0, 1)"
         )));
     }
-    let opts = lighting::LightingOptions {
+    let opts = lighting_gap::LightingOptions {
         width: file.render.width,
         height: file.render.height,
         scene: file,
@@ -118,7 +118,7 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
     };
     let ctx = Context::new(context)?;
     let json = args.json;
-    let rows = lighting::run(&ctx, &opts, |r| {
+    let rows = lighting_gap::run(&ctx, &opts, |r| {
         if !json {
             eprintln!(
                 "{}: {} light(s) extracted; mean error {:.1} % → {:.1} % (reference {:.0} s)",
@@ -133,7 +133,7 @@ pub fn reference(args: ReferenceArgs, context: &ContextOptions) -> dermis::Resul
     if json {
         outln!("{}", to_json(Path::new("stdout"), &rows)?);
     } else {
-        out!("{}", lighting::table(&rows));
+        out!("{}", lighting_gap::table(&rows));
     }
     Ok(())
 }
@@ -147,8 +147,8 @@ fn diffusion(
     json: bool,
     context: &ContextOptions,
 ) -> dermis::Result<()> {
+    use dermis::fidelity::diffusion_gap as d;
     use dermis::scene::file::Chain;
-    use dermis::sweep::diffusion as d;
     let stride = stride.unwrap_or((file.render.irradiance_resolution / 256).max(1));
     if stride == 0 {
         return Err(dermis::Error::Input("--stride 0: give 1 or more".into()));

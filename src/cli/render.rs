@@ -72,13 +72,13 @@ pub struct RenderArgs {
     /// Also time three ruler passes at the irradiance resolution (an RGBA16F
     /// copy, `ruler_copy`, a read, `ruler_read`, and one workgroup of the read,
     /// `ruler_empty`) and report every pass's ns/texel
-    /// as a multiple of the copy's (docs/performance.md).
+    /// as a multiple of the copy's (docs/guide/measure.md).
     #[arg(long)]
     ruler: bool,
     /// Count every pass's work with pipeline statistics queries (vertices,
     /// primitives, vertex, fragment and compute invocations) into the timing
     /// table, report, CSV and trace; needs the device's
-    /// pipelineStatisticsQuery feature (docs/performance.md, "Work counters").
+    /// pipelineStatisticsQuery feature (docs/design/pass-analysis.md, "Work counters").
     #[arg(long)]
     counters: bool,
 }
@@ -174,10 +174,10 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         write_file(&path, &to_json(&path, r)?)?;
     }
     if let Some(path) = args.trace {
-        write_file(&path, &to_json(&path, &dermis::profile::trace::trace(r))?)?;
+        write_file(&path, &to_json(&path, &dermis::timing::trace::trace(r))?)?;
     }
     if let Some(path) = args.csv {
-        write_file(&path, &dermis::profile::csv::csv(r))?;
+        write_file(&path, &dermis::timing::csv::csv(r))?;
     }
     outln!(
         "wrote {} (exposure {:+.2} EV, {})",

@@ -63,7 +63,7 @@ pub struct SweepArgs {
     /// Render only this shard of the points: I/N (1-based; same as hash:I/N, by a
     /// hash of each point's id, stable as points are added), count:I/N (every
     /// N-th point from the I-th: balanced), or auto (from Slurm, Kubernetes,
-    /// GitLab, Bazel or DERMIS_SHARD; see docs/performance.md). Without it,
+    /// GitLab, Bazel or DERMIS_SHARD; see docs/guide/sweep.md). Without it,
     /// DERMIS_SHARD (same syntax) is read. Writes points-shard-I-of-N.jsonl
     /// into --out-dir; merge with `dermis sweep merge`.
     #[arg(long, value_name = "I/N|hash:I/N|count:I/N|auto")]

@@ -2,12 +2,13 @@
 //! image pool, per-pass debug labels, GPU timestamps and, when asked for,
 //! pipeline statistics (work counters).
 
+use super::commands::{barriers, begin_rendering};
 use super::pass_cx::{PassCx, ResolvedImage};
-use super::plan::{Barrier, Plan, PoolState};
-use super::{Graph, Imported, LoadOp, ResourceKind};
+use super::plan::{Plan, PoolState};
+use super::{Graph, Imported, ResourceKind};
 use crate::error::{Error, Result, VkResultExt};
-use crate::gpu::{full_range, Context, Image};
-use crate::profile::{CpuSpan, FrameReport, PassCounters, PassTime, PassWork};
+use crate::gpu::{Context, Image};
+use crate::timing::{CpuSpan, FrameTiming, PassCounters, PassTime, PassWork};
 use ash::vk;
 use std::ffi::CString;
 use std::sync::Arc;
@@ -242,12 +243,12 @@ impl Executor {
 
     /// Compiles and submits; returns the report of the frame that last used this
     /// frame slot, if any (it has completed).
-    pub fn run(&mut self, graph: Graph) -> Result<Option<FrameReport>> {
+    pub fn run(&mut self, graph: Graph) -> Result<Option<FrameTiming>> {
         let compiled = self.compile(graph)?;
         self.submit(compiled)
     }
 
-    pub fn submit(&mut self, compiled: Compiled) -> Result<Option<FrameReport>> {
+    pub fn submit(&mut self, compiled: Compiled) -> Result<Option<FrameTiming>> {
         self.submit_synced(compiled, FrameSync::default())
     }
 
@@ -258,7 +259,7 @@ impl Executor {
         &mut self,
         compiled: Compiled,
         sync: FrameSync,
-    ) -> Result<Option<FrameReport>> {
+    ) -> Result<Option<FrameTiming>> {
         let index = self.next;
         let previous = self.retire(index)?;
         self.realize_pool()?;
@@ -370,7 +371,7 @@ impl Executor {
         buffers: &[Option<vk::Buffer>],
         names: Vec<String>,
         sync: FrameSync,
-    ) -> Result<FrameReport> {
+    ) -> Result<FrameTiming> {
         let fence = self.slots[index].fence;
         let d = &self.ctx.device;
         let frame_start = Instant::now();
@@ -407,7 +408,7 @@ impl Executor {
                 });
             }
         }
-        Ok(FrameReport {
+        Ok(FrameTiming {
             frame: self.frame,
             start_ns: Some((frame_start - epoch).as_nanos() as f64),
             passes,
@@ -428,7 +429,7 @@ impl Executor {
     }
 
     /// Waits for every frame in flight; returns their reports in submission order.
-    pub fn finish(&mut self) -> Result<Vec<FrameReport>> {
+    pub fn finish(&mut self) -> Result<Vec<FrameTiming>> {
         let mut reports = Vec::new();
         for k in 0..self.slots.len() {
             let index = (self.next + k) % self.slots.len();
@@ -450,7 +451,7 @@ impl Executor {
     }
 
     /// Waits for the frame in `index` (if any) and turns its timestamps into a report.
-    fn retire(&mut self, index: usize) -> Result<Option<FrameReport>> {
+    fn retire(&mut self, index: usize) -> Result<Option<FrameTiming>> {
         let Some(done) = self.slots[index].in_flight.take() else {
             return Ok(None);
         };
@@ -472,7 +473,7 @@ impl Executor {
             }
             .vk("vkGetQueryPoolResults")?;
             let info = &self.ctx.info;
-            let mut report = FrameReport::from_timestamps(
+            let mut report = FrameTiming::from_timestamps(
                 done.frame,
                 &done.pass_names,
                 &raw,
@@ -497,7 +498,7 @@ impl Executor {
             report
         } else {
             // No timestamps on this device: passes are listed without GPU times.
-            FrameReport::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
+            FrameTiming::from_timestamps(done.frame, &done.pass_names, &[], 64, 1.0)
         };
         report.set_work(&done.work);
         report.cpu_spans = done.spans;
@@ -672,7 +673,7 @@ impl Executor {
         for i in range {
             let (planned, pass) = (&c.plan.passes[i], &c.graph.passes[i]);
             self.label_begin(cmd, &planned.name);
-            self.barriers(cmd, &planned.barriers, images, buffers);
+            barriers(&self.ctx.device, cmd, &planned.barriers, images, buffers);
             if counting {
                 unsafe {
                     d.cmd_begin_query(cmd, slot.stats, i as u32, vk::QueryControlFlags::empty())
@@ -681,7 +682,7 @@ impl Executor {
             timestamp(2 + 2 * i as u32);
             let rendering = !pass.attachments.is_empty();
             if rendering {
-                self.begin_rendering(cmd, pass, images);
+                begin_rendering(&self.ctx.device, cmd, pass, images);
             }
             if let Some(record) = &pass.record {
                 record(&cx);
@@ -696,135 +697,16 @@ impl Executor {
             self.label_end(cmd);
         }
         if last {
-            self.barriers(cmd, &c.plan.final_barriers, images, buffers);
+            barriers(
+                &self.ctx.device,
+                cmd,
+                &c.plan.final_barriers,
+                images,
+                buffers,
+            );
             timestamp(1);
         }
         unsafe { d.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")
-    }
-
-    fn barriers(
-        &self,
-        cmd: vk::CommandBuffer,
-        barriers: &[Barrier],
-        images: &[Option<ResolvedImage>],
-        buffers: &[Option<vk::Buffer>],
-    ) {
-        if barriers.is_empty() {
-            return;
-        }
-        let mut image_barriers = Vec::new();
-        let mut buffer_barriers = Vec::new();
-        for b in barriers {
-            match (b.layouts, images[b.resource], buffers[b.resource]) {
-                (Some((old, new)), Some(img), _) => image_barriers.push(
-                    vk::ImageMemoryBarrier2::default()
-                        .src_stage_mask(b.src_stage)
-                        .src_access_mask(b.src_access)
-                        .dst_stage_mask(b.dst_stage)
-                        .dst_access_mask(b.dst_access)
-                        .old_layout(old)
-                        .new_layout(new)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(img.raw)
-                        .subresource_range(full_range(img.desc.format, img.desc.mip_levels)),
-                ),
-                (None, _, Some(buffer)) => buffer_barriers.push(
-                    vk::BufferMemoryBarrier2::default()
-                        .src_stage_mask(b.src_stage)
-                        .src_access_mask(b.src_access)
-                        .dst_stage_mask(b.dst_stage)
-                        .dst_access_mask(b.dst_access)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .buffer(buffer)
-                        .offset(0)
-                        .size(vk::WHOLE_SIZE),
-                ),
-                _ => {}
-            }
-        }
-        let dep = vk::DependencyInfo::default()
-            .image_memory_barriers(&image_barriers)
-            .buffer_memory_barriers(&buffer_barriers);
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
-    }
-
-    fn begin_rendering(
-        &self,
-        cmd: vk::CommandBuffer,
-        pass: &super::PassDecl,
-        images: &[Option<ResolvedImage>],
-    ) {
-        let attachment = |a: &super::Attachment| {
-            let img = images[a.resource].expect("attachments are images");
-            let (load_op, clear) = match a.load {
-                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
-                LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
-                LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
-            };
-            let clear_value = if a.depth {
-                vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: clear[0],
-                        stencil: 0,
-                    },
-                }
-            } else {
-                vk::ClearValue {
-                    color: vk::ClearColorValue { float32: clear },
-                }
-            };
-            let layout = if a.depth {
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL
-            } else {
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
-            };
-            let info = vk::RenderingAttachmentInfo::default()
-                .image_view(img.view)
-                .image_layout(layout)
-                .load_op(load_op)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(clear_value);
-            (info, img.desc.extent())
-        };
-        let colors: Vec<_> = pass
-            .attachments
-            .iter()
-            .filter(|a| !a.depth)
-            .map(|a| attachment(a).0)
-            .collect();
-        let depth = pass.attachments.iter().find(|a| a.depth).map(attachment);
-        let extent = pass
-            .attachments
-            .first()
-            .map(|a| attachment(a).1)
-            .unwrap_or_default();
-        let area = vk::Rect2D {
-            offset: vk::Offset2D { x: 0, y: 0 },
-            extent,
-        };
-        let mut info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&colors);
-        if let Some((d, _)) = &depth {
-            info = info.depth_attachment(d);
-        }
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: extent.width as f32,
-            height: extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
-        unsafe {
-            let d = &self.ctx.device;
-            d.cmd_begin_rendering(cmd, &info);
-            d.cmd_set_viewport(cmd, 0, &[viewport]);
-            d.cmd_set_scissor(cmd, 0, &[area]);
-        }
     }
 
     fn label_begin(&self, cmd: vk::CommandBuffer, name: &str) {

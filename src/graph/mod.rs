@@ -7,6 +7,7 @@
 //! reads `&` handles (kajiya-rg), so the code shows who mutates what.
 
 mod access;
+mod commands;
 mod cull;
 mod execute;
 mod pass_cx;

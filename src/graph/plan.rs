@@ -4,7 +4,7 @@
 use super::{Access, Graph, ResourceKind};
 use crate::error::{Error, Result};
 use crate::gpu::ImageDesc;
-use crate::profile::PassWork;
+use crate::timing::PassWork;
 use ash::vk;
 use std::fmt;
 
@@ -25,7 +25,7 @@ pub struct PlannedPass {
     pub name: String,
     /// Issued as one `vkCmdPipelineBarrier2` before the pass.
     pub barriers: Vec<Barrier>,
-    /// What the pass is measured against, and its tags (profile::PassWork).
+    /// What the pass is measured against, and its tags (timing::PassWork).
     pub work: PassWork,
 }
 

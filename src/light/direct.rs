@@ -3,7 +3,7 @@
 //! plus the shadowed lights, for comparison with texture-space diffusion.
 
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;

@@ -3,7 +3,7 @@
 //! of the map, each to be lit as a shadowed directional light of the same power
 //! and colour; the smooth residual is what the SH projection and the specular
 //! prefilter see. Nine SH coefficients cannot represent such a source
-//! (docs/lighting.md, "Bright-source extraction", has the reasoning behind every
+//! (docs/design/lighting.md, "Bright-source extraction", has the reasoning behind every
 //! threshold and what it gives on the CC0 maps).
 //!
 //! # Algorithm
@@ -53,7 +53,7 @@ use crate::scene::texture::LUMINANCE;
 pub const CORE_CONTRAST: f32 = 100.0;
 /// The least share of the map's energy (luminance of `∫ L dω`) an `Auto` light
 /// holds. A point source of share `s` costs SH9 up to 0.375·s of the map's mean
-/// irradiance (docs/lighting.md): below 5 % that is under the 2 % SH9 already
+/// irradiance (docs/design/lighting.md): below 5 % that is under the 2 % SH9 already
 /// misses on the smooth maps (sunset, venice_sunset).
 pub const MIN_SHARE: f32 = 0.05;
 /// The largest solid angle of an `Auto` light: a disc of 10.2° radius, whose
@@ -821,7 +821,7 @@ mod tests {
     /// Per-normal relative error (mean, max) of the irradiance of SH9 of
     /// `residual` plus `lights` as point sources against brute-force
     /// integration of `env`, over 256 well-spread normals (the metric of
-    /// `light::sh`'s table in docs/lighting.md).
+    /// `light::sh`'s table in docs/design/lighting.md).
     fn sh9_error(env: &EnvMap, residual: &EnvMap, lights: &[ExtractedLight]) -> (f32, f32) {
         use crate::light::sh;
         let normals: Vec<Vec3> = (0..256)
@@ -850,7 +850,7 @@ mod tests {
         (mean, errors.iter().fold(0.0, |a, &b| a.max(b)))
     }
 
-    /// What `Auto` takes from the six CC0 maps (the table of docs/lighting.md),
+    /// What `Auto` takes from the six CC0 maps (the table of docs/design/lighting.md),
     /// and the SH9 irradiance error with and without the lights taken out:
     /// `cargo test --release --lib light::extract::tests::cc0 -- --nocapture`.
     #[test]

@@ -20,7 +20,7 @@
 //! # What is left out
 //! Back faces (the inside of the head) reflect nothing. The hit reflects
 //! `ρ·E`: its oil layer takes ρs·Ā ≈ 4 % of the light from the diffuse
-//! (docs/skin.md) and reflects it itself, so `ρ`, the albedo map, stands for
+//! (docs/design/skin.md) and reflects it itself, so `ρ`, the albedo map, stands for
 //! both within ρs·Ā·(1 − ρ) ≈ 2 % of the hit's light. The GPU applies `B` to the
 //! environment's SH and to the explicit lights projected into SH at the
 //! receiving vertex (`uv_lit.vert`, `irradiance_vertices.comp`), so a lamp's light bounces as if the

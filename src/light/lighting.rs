@@ -7,7 +7,7 @@
 
 use super::extract::ExtractedLight;
 use super::shadow::{Focus, ShadowMaps, ShadowView};
-use crate::frame::MAX_LIGHTS;
+use crate::frame_inputs::MAX_LIGHTS;
 use crate::scene::camera::Camera;
 use crate::scene::file::Occlusion;
 use crate::scene::mesh::Mesh;

@@ -5,12 +5,12 @@
 
 use super::sh::{self, Sh9};
 use crate::error::Result;
-use crate::frame::upload_env;
+use crate::frame_inputs::upload_env;
 use crate::gpu::{Buffer, Context, Image, MemoryLocation, Pipeline, Pipelines, Sampler};
 use crate::graph::upload::{upload_buffer, Readback};
 use crate::graph::{Access, BufferHandle, Executor, Graph, Imported};
-use crate::profile::FrameReport;
 use crate::scene::env::EnvMap;
+use crate::timing::FrameTiming;
 use ash::vk;
 use glam::{Mat3, Vec3};
 use std::sync::Arc;
@@ -156,7 +156,7 @@ pub fn project(
     env: &EnvMap,
     rotation_deg: f32,
     intensity: f32,
-) -> Result<(Sh9, FrameReport)> {
+) -> Result<(Sh9, FrameTiming)> {
     let image = upload_env(ctx, env, 1.0)?;
     let passes = ShPasses::new(
         &Pipelines::new(ctx),
@@ -168,7 +168,7 @@ pub fn project(
     let coefficients = passes.passes(&mut g, &image, &buffers);
     readback.buffer_pass(&mut g, &coefficients);
     let mut ex = Executor::new(ctx, 1)?;
-    let mut reports: Vec<FrameReport> = ex.run(g)?.into_iter().collect();
+    let mut reports: Vec<FrameTiming> = ex.run(g)?.into_iter().collect();
     reports.extend(ex.finish()?);
     let v: &[f32] = bytemuck::cast_slice(readback.bytes()?);
     let coeffs = std::array::from_fn(|i| Vec3::new(v[4 * i], v[4 * i + 1], v[4 * i + 2]));

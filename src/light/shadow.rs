@@ -4,7 +4,7 @@
 //! with 3×3 bilinear PCF, or for a source of angular size with soft shadows.
 
 use crate::error::Result;
-use crate::frame::{MeshBuffers, Vertex, SHADOW_FORMAT};
+use crate::frame_inputs::{MeshBuffers, Vertex, SHADOW_FORMAT};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use crate::scene::LightSource;

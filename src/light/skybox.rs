@@ -2,7 +2,7 @@
 //! its pipeline from the render's cache (gpu::Pipelines).
 
 use crate::error::Result;
-use crate::frame::{FrameInputs, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame_inputs::{FrameInputs, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 

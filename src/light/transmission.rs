@@ -2,7 +2,7 @@
 //! a per-vertex transfer of the SH environment entering the skin's far side
 //! and diffusing through to the near one, the environment's counterpart of
 //! the final pass's translucent shadow maps for the explicit lights
-//! (docs/skin.md, "Transmission").
+//! (docs/records/2026-11-26-transmission.md, "Transmission").
 //!
 //! # What is computed
 //! Light entering the surface at q with irradiance E(q) leaves at p with the

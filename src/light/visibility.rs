@@ -11,7 +11,7 @@
 //! in 8-bit steps, once per lighting instead of every frame (issue 24).
 
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex};
+use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};
 use ash::vk;
@@ -20,12 +20,12 @@ use std::sync::Arc;
 /// Largest side of the visibility textures. The diffusion blurs the irradiance
 /// they shadow; 1024² is ~0.6 mm per texel on the scan, the shadow atlas's
 /// 2048² tiles ~0.25 mm. Half the irradiance resolution costs no measurable
-/// accuracy against the reference (docs/lighting.md) and a quarter of the time.
+/// accuracy against the reference (docs/design/lighting.md) and a quarter of the time.
 pub const MAX_RESOLUTION: u32 = 1024;
 /// Three lights per texture (RGB), coverage in alpha, 8 bits each.
 pub const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// Textures the shaders bind (common/lights.glsl SOFT_VISIBILITY): nine lights,
-/// more than frame::MAX_LIGHTS.
+/// more than frame_inputs::MAX_LIGHTS.
 pub const TEXTURES: usize = 3;
 
 pub struct VisibilityPass {

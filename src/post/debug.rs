@@ -4,7 +4,7 @@
 //! are (post::Display::data), the albedo as a colour.
 
 use crate::error::Result;
-use crate::frame::{upload_rgba8, FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame_inputs::{upload_rgba8, FrameInputs, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use crate::scene::texture::Texture;

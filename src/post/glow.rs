@@ -15,7 +15,7 @@
 //! Passes: `glow_downK` (K = 1…), `glowI_u`, `glowI_v` (I = 1, 2), `glow`.
 
 use crate::error::Result;
-use crate::frame::HDR_FORMAT;
+use crate::frame_inputs::HDR_FORMAT;
 use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines, Sampler};
 use crate::graph::{Graph, ImageHandle, LoadOp};
 use std::sync::Arc;

@@ -1,4 +1,4 @@
-//! Post-processing after shading (the paper's §IV; docs/post.md): metering,
+//! Post-processing after shading (the paper's §IV; docs/design/post.md): metering,
 //! glow, exposure and tone mapping, and the debug views drawn for it.
 
 pub mod debug;

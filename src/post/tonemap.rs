@@ -1,5 +1,5 @@
 //! Exposure, the tone curve and the output transfer function into an 8-bit
-//! target (docs/post.md). The CPU functions here are written from the published
+//! target (docs/design/post.md). The CPU functions here are written from the published
 //! formulas and are the reference the pass is tested against; [`encode8`] also
 //! encodes images read back as floats (UV-space views, the CPU reference).
 //!

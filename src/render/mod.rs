@@ -2,7 +2,7 @@
 //! graph, run it for a number of frames, read the image and the exposure back,
 //! and report per-pass timings; the debug sheet and the occlusion comparison.
 
-mod frame;
+mod frame_graph;
 pub mod output;
 pub mod progress;
 pub mod ruler;
@@ -20,13 +20,13 @@ use crate::light::reference::{render_view_with, ReferenceImage, Settings as Refe
 use crate::post::meter::{self, Metered};
 use crate::post::tonemap::encode8;
 use crate::post::{Exposure, PostSettings};
-use crate::profile::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
 use crate::scene::checker;
 use crate::scene::file::{Chain, Gamma, Kernel, Occlusion, UvOrigin};
 use crate::scene::texture::flip_rows;
 use crate::scene::Scene;
 use crate::skin::SkinSettings;
-use frame::Frame;
+use crate::timing::{CameraSetup, MemoryUse, PipelineTime, RunReport, RunSetup};
+use frame_graph::Frame;
 use progress::Progress;
 use sheet::Sheet;
 use std::path::PathBuf;
@@ -65,7 +65,7 @@ pub struct RenderOptions {
 
 /// The default pre-roll on GPUs. An NVIDIA H200 left idle between a sweep's
 /// points measured the next point at 345–750 MHz instead of 1980: its raster
-/// passes up to 5.6× slower (docs/performance.md, "On a real GPU").
+/// passes up to 5.6× slower (docs/records/2026-11-26-h200.md).
 pub const PREROLL_GPU_MS: u32 = 1000;
 
 impl RenderOptions {

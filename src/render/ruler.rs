@@ -5,12 +5,12 @@
 //! invocation of the read (what any pass costs before its work). A pass's
 //! ns/texel over the copy's (`x_ruler` in reports) survives a noisy machine
 //! better than milliseconds; the copy's bandwidth and the empty pass's time
-//! are what profile::bound judges passes by.
+//! are what timing::bound judges passes by.
 
 use crate::error::Result;
 use crate::gpu::{ImageDesc, Pipelines, Sampler};
 use crate::graph::{Graph, ImageHandle};
-use crate::profile::{RULER_COPY, RULER_EMPTY, RULER_READ};
+use crate::timing::{RULER_COPY, RULER_EMPTY, RULER_READ};
 use std::sync::Arc;
 
 /// The tag of the ruler passes.

@@ -4,16 +4,16 @@
 //! only makes the frame's uniforms again, turning the environment also its SH
 //! and the lights' shadows; anything else is a new session.
 
-use super::frame::Frame;
+use super::frame_graph::Frame;
 use super::{check_target, settings, View};
 use crate::error::Result;
 use crate::gpu::{Context, Image, ImageDesc};
 use crate::graph::{Access, Executor, Graph, Imported, Kept};
 use crate::post::PostSettings;
-use crate::profile::FrameReport;
 use crate::scene::camera::Camera;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
+use crate::timing::FrameTiming;
 use ash::vk;
 use std::sync::Arc;
 
@@ -110,7 +110,7 @@ impl Session {
     /// Renders `view` once and waits for it: the displayable image (RGBA8,
     /// sRGB-encoded, left in SHADER_READ_ONLY_OPTIMAL for fragment sampling)
     /// and the frame's report.
-    pub fn render(&mut self, view: &View) -> Result<(Arc<Image>, Option<FrameReport>)> {
+    pub fn render(&mut self, view: &View) -> Result<(Arc<Image>, Option<FrameTiming>)> {
         let size = (self.scene.file.render.width, self.scene.file.render.height);
         let mut g = Graph::with_kept(self.kept.clone());
         let images = self.frame.graph(&mut g, view, size)?;

@@ -1,7 +1,7 @@
 //! The command-line flags that replace scene-file keys. One table entry per flag
 //! gives its help, clap attributes, type, the key it replaces and an example
 //! value; [`Overrides`], its `apply` and [`Overrides::KEYS`] follow from it
-//! (docs/architecture.md, "Adding a CLI flag for a scene key").
+//! (docs/design/architecture.md, "Adding a CLI flag for a scene key").
 
 use std::path::PathBuf;
 
@@ -15,9 +15,9 @@ use crate::error::Result;
 /// `--scene`, for every command that reads a scene.
 #[derive(Clone, Debug, Default, clap::Args)]
 pub struct SceneArg {
-    /// Scene file (docs/scene-format.md), or `builtin` for the built-in
+    /// Scene file (docs/reference/scene-format.md), or `builtin` for the built-in
     /// procedural head under the sky; default: assets/default.toml, looked for
-    /// in $DERMIS_ASSETS, ./assets, then beside the executable (README.md, "Assets").
+    /// in $DERMIS_ASSETS, ./assets, then beside the executable (docs/reference/command-line.md, "Assets").
     #[arg(long)]
     pub scene: Option<PathBuf>,
 }
@@ -158,7 +158,7 @@ overrides! {
     /// The skin's medium, replacing `skin.medium.preset`: `deon2007` (the
     /// paper's Gaussians) or one of Jensen et al. 2001's measured media, from
     /// which the profile, the transmission and the specular follow
-    /// (docs/skin.md, "Media").
+    /// (docs/design/media.md).
     #[arg(value_enum)]
     medium: MediumPreset => skin.medium.preset, example "jensen-skin1";
     /// Blur along the surface metric of the UVs, shear included (off: along u

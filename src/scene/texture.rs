@@ -14,7 +14,7 @@ use super::file::SceneError;
 /// Largest accepted width or height (also the render-size limit of the scene file).
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
 
-/// Stand-ins for maps a scene leaves out (docs/scene-format.md, `[textures]`).
+/// Stand-ins for maps a scene leaves out (docs/reference/scene-format.md, `[textures]`).
 /// Albedo: sRGB 188 = linear 0.50 (IEC 61966-2-1), a neutral mid grey.
 pub const DEFAULT_ALBEDO_SRGB: [u8; 4] = [188, 188, 188, 255];
 /// Tangent-space (0, 0, 1): `n = 2·rgb/255 − 1`.

@@ -85,7 +85,7 @@ impl Rgb {
     }
 }
 
-/// The most forward vertex (+Z, glTF's front; docs/scene-format.md) within
+/// The most forward vertex (+Z, glTF's front; docs/reference/scene-format.md) within
 /// `r` mm of (x, y).
 fn front_vertex(mesh: &Mesh, x: f32, y: f32, r: f32) -> usize {
     (0..mesh.vertex_count())

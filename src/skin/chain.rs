@@ -4,7 +4,7 @@
 //! [`MIN_SIGMA_TEXELS`] texels, downsampling as it blurs (the Gaussian is the
 //! low-pass filter), and takes the unblurred irradiance for a first Gaussian
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
-//! first term). docs/performance.md shows what it costs and how far it is off.
+//! first term). docs/design/cost-model.md shows what it costs and how far it is off.
 //! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
 //! of its source's resolution is blurred in one pass instead of two (issue 24);
 //! so is a level that halves its source's side, with the 5×5 stencil, where
@@ -17,7 +17,7 @@ use crate::scene::file::Chain;
 /// Smallest total σ, in texels of its own resolution at the mesh's mean stretch,
 /// a level after the first is stored with: a Gaussian narrower than a texel is
 /// not reconstructed by bilinear lookups (the impulse-response test of
-/// tests/it/skin_diffusion.rs fails from about 0.7; docs/performance.md).
+/// tests/it/skin_diffusion.rs fails from about 0.7; docs/design/cost-model.md).
 pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 /// A first increment narrower than this (texels at the irradiance resolution) is
 /// not blurred: the level is the irradiance itself.

@@ -2,15 +2,15 @@
 //! the SH environment and the shadowed explicit lights, times albedo^mix. What
 //! no light changes is drawn once per render over a raster of the mesh by its
 //! UVs and kept (the mesh, its maps and the skin settings are fixed for a
-//! render; issue 24, docs/performance.md):
+//! render; docs/design/cost-model.md):
 //! - `surface`: the normal-mapped shading normal, albedo^mix, the specular's
 //!   (ρs, m) and the share of the environment's light it lets in, 1 − ρs·Ā(m);
 //! - `texel_map`, for the compute formulation below: per texel the covering
 //!   triangle's three vertices and its weights on them (texel_map.vert).
 //!
 //! Each frame lights every covered texel, one of two ways
-//! (`render.irradiance_shading`; docs/performance.md, "The irradiance pass in
-//! compute"): the mesh rasterised by its UVs (`uv_lit.vert`,
+//! (`render.irradiance_shading`; docs/records/2026-11-27-compute-irradiance.md):
+//! the mesh rasterised by its UVs (`uv_lit.vert`,
 //! `irradiance.frag`), or `irradiance_vertices`, which evaluates what is
 //! interpolated (the position and the environment's irradiance through the
 //! transfer) at every vertex, then a compute pass over the texel map that
@@ -21,7 +21,7 @@
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, Samplers, ShaderVariant};
+use crate::frame_inputs::{FrameInputs, Samplers, ShaderVariant};
 use crate::gpu::{GraphicsDesc, Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, BufferHandle, Graph, ImageHandle, LoadOp, SimplePass};
 use crate::scene::file::IrradianceShading;

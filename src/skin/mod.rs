@@ -19,7 +19,7 @@ pub mod translucent;
 pub mod walk;
 
 use crate::error::{Error, Result};
-use crate::frame::Vertex;
+use crate::frame_inputs::Vertex;
 use crate::gpu::{GraphicsDesc, Pipeline, Pipelines};
 use crate::scene::file::{
     Chain, Kernel as KernelChoice, Render, Skin, SpecularRegion, SpecularRule,

@@ -10,7 +10,7 @@
 //!
 //! Units: distances in mm, variances in mm²; blur kernels are expressed in
 //! units of the Gaussian's standard deviation σ, and [`convolve_1d`] takes σ in
-//! texels. See `docs/skin.md` for the measured kernel errors.
+//! texels. See `docs/design/skin.md` for the measured kernel errors.
 
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -282,7 +282,7 @@ impl Kernel {
 ///
 /// Note that linear interpolation at a fractional position adds spread of its
 /// own (a tap at fraction f adds variance f(1−f) texel², 1/6 on average), which
-/// matters when σ is a few texels; `docs/skin.md` lists the measured errors.
+/// matters when σ is a few texels; `docs/design/skin.md` lists the measured errors.
 /// GPUs also quantise the interpolation fraction (8 bits on most hardware and
 /// lavapipe); this reference does not.
 pub fn convolve_1d(signal: &[f32], kernel: &Kernel, sigma_texels: f32) -> Vec<f32> {
@@ -531,7 +531,7 @@ mod tests {
     #[test]
     fn delta_response_report() {
         // An impulse is the worst input for sparse taps: with spacing above a
-        // texel the output is a comb. Reported, not asserted (see docs/skin.md).
+        // texel the output is a comb. Reported, not asserted (see docs/design/skin.md).
         let k = Kernel::accurate(ACCURATE_MAX_SPACING_SIGMA, ACCURATE_EXTENT_SIGMA);
         let d = Kernel::deon7();
         println!("impulse input: error in % of peak");

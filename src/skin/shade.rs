@@ -1,11 +1,11 @@
 //! Final skin shading in screen space (GPU Gems 3 §14.5; the paper's Fig. 2):
 //! Σ w_i · blur_i with the profile's RGB weights, × albedo^(1−mix), / π, plus the
 //! KS specular of the lights and the environment, and the light of shadowed
-//! lights transmitted through thin skin (docs/skin.md, "Transmission").
+//! lights transmitted through thin skin (docs/records/2026-11-26-transmission.md, "Transmission").
 
 use super::tables::SpecularTables;
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
+use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex, DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::{GraphicsDesc, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{BufferHandle, Graph, ImageHandle, LoadOp};
 use ash::vk;
@@ -66,7 +66,7 @@ pub enum ShadeMode {
     Diffuse = 1,
     Specular = 2,
     /// The light of shadowed lights behind the skin transmitted through it,
-    /// as it adds to the final image (docs/skin.md, "Transmission").
+    /// as it adds to the final image (docs/records/2026-11-26-transmission.md, "Transmission").
     Transmission = 3,
 }
 

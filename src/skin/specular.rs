@@ -10,11 +10,11 @@
 //! - Kelemen & Szirmay-Kalos 2001, "A Microfacet Based Coupled Specular-Matte
 //!   BRDF Model with Importance Sampling".
 //!
-//! Conventions (see `docs/skin.md`): vectors are unit length and point away
+//! Conventions (see `docs/design/skin.md`): vectors are unit length and point away
 //! from the surface; `m` is the Beckmann RMS slope; `rho_s` is the specular
 //! intensity. [`beckmann`] is normalised (it carries the 1/π of eq. 1); the lobe
 //! [`ks_brdf`] uses d'Eon's [`beckmann_ph`], which has no 1/π, because ρ_s = 0.18
-//! and m = 0.3 are d'Eon's values for that lobe (the calibration in `docs/skin.md`).
+//! and m = 0.3 are d'Eon's values for that lobe (the calibration in `docs/design/skin.md`).
 
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -391,7 +391,7 @@ pub const REGION_NAMES: [&str; 10] = [
 /// Every region at d'Eon's defaults m = 0.3, ρ_s = 0.18 (GPU Gems 3 §14.3).
 /// Weyrich et al. 2006's measured per-region values are printed only in figures
 /// (their paper; GPU Gems 3 §14.3 reproduces them as a figure) and no machine-readable copy was found,
-/// so none are transcribed here; see `docs/skin.md`.
+/// so none are transcribed here; see `docs/design/skin.md`.
 pub fn default_regions() -> [Region; 10] {
     REGION_NAMES.map(|name| Region {
         name,

@@ -12,7 +12,7 @@ use super::blur::BlurChain;
 use super::profile::Profile;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::MeshBuffers;
+use crate::frame_inputs::MeshBuffers;
 use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::{Access, Graph, ImageHandle, Imported, LoadOp};
 use ash::vk;

@@ -5,7 +5,7 @@
 
 use super::specular;
 use crate::error::Result;
-use crate::frame::FrameInputs;
+use crate::frame_inputs::FrameInputs;
 use crate::gpu::{Context, Image, ImageDesc, Sampler};
 use crate::graph::upload::upload_texture;
 use crate::graph::SimplePass;

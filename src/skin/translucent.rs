@@ -1,18 +1,18 @@
 //! The shadowed lights' light through thin skin (translucent shadow maps,
-//! d'Eon & Luebke §14.5.3; Jimenez et al. 2010; docs/skin.md, "Transmission"),
+//! d'Eon & Luebke §14.5.3; Jimenez et al. 2010; docs/records/2026-11-26-transmission.md, "Transmission"),
 //! in texture space, once per lighting: it depends on the lights, their shadow
 //! atlas, the mesh and its maps, not on the camera, so it is drawn by the
 //! render's first frame that needs it and kept by the atlas's key, as the soft
 //! lights' visibility is (light::visibility). Both sides of the surface
 //! (translucent.frag); the final pass reads the side it shades with one
 //! bilinear lookup instead of a shadow-map thickness and six exponentials per
-//! light and pixel (issue 24; docs/performance.md).
+//! light and pixel (docs/design/cost-model.md).
 
 use super::medium_tables::MediumTables;
 use super::tables::SpecularTables;
 use super::{uv_pipeline, UV_FORMAT};
 use crate::error::Result;
-use crate::frame::{FrameInputs, ShaderVariant};
+use crate::frame_inputs::{FrameInputs, ShaderVariant};
 use crate::gpu::{Image, ImageDesc, Pipeline, Pipelines};
 use crate::graph::upload::upload_texture;
 use crate::graph::{Access, Graph, ImageHandle, LoadOp};

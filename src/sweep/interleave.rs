@@ -4,7 +4,7 @@
 //! for `dermis compare`.
 
 use crate::error::{Error, Result};
-use crate::profile::compare::Measurement;
+use crate::timing::regression::Measurement;
 use std::path::{Path, PathBuf};
 
 /// Options `interleave` sets itself on each run.
@@ -89,7 +89,7 @@ pub fn run(
         }
     }
     let pool = |f: &[PathBuf]| -> Result<(Measurement, Vec<String>)> {
-        let (mut m, w) = super::compare::pool(f)?;
+        let (mut m, w) = super::side::pool(f)?;
         m.source = format!("{} × {}", f.len(), f[0].display());
         Ok((m, w))
     };

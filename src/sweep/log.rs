@@ -7,7 +7,7 @@
 use super::shard::Shard;
 use super::{Point, Sweep, Variant};
 use crate::error::{Error, Result};
-use crate::profile::Fingerprint;
+use crate::timing::Fingerprint;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::{Path, PathBuf};

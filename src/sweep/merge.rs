@@ -13,7 +13,7 @@ use super::points::SWEEP_SCHEMA_VERSION;
 use super::shard::{self, Mode, Shard, Spec};
 use super::{ShardRun, Sweep};
 use crate::error::{Error, Result};
-use crate::profile::fingerprint::{run_id, timestamp};
+use crate::timing::fingerprint::{run_id, timestamp};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -285,11 +285,11 @@ pub fn default_out_dir(paths: &[PathBuf]) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::Fingerprint;
     use crate::scene::file::{Chain, Kernel};
     use crate::sweep::log::Header;
     use crate::sweep::metric::ImageError;
     use crate::sweep::{Point, Variant};
+    use crate::timing::Fingerprint;
 
     fn variant(resolution: u32) -> Variant {
         Variant {

@@ -3,10 +3,7 @@
 //! final image and the diffuse term with a reference (by default 4096², accurate
 //! kernel, full chain) over the face. Writes a CSV, a JSON and plots.
 
-pub mod compare;
-pub mod diffusion;
 pub mod interleave;
-pub mod lighting;
 pub mod log;
 pub mod merge;
 pub mod metric;
@@ -14,16 +11,17 @@ pub mod output;
 pub mod plot;
 pub mod points;
 pub mod shard;
+pub mod side;
 
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::profile::csv::field;
-use crate::profile::fingerprint::{run_id, timestamp};
-use crate::profile::{Fingerprint, PassStats, RunReport, GIT_COMMIT, RULER_COPY, VERSION};
 use crate::render::progress::Task;
 use crate::render::{render_scene, RenderOptions, View};
 use crate::scene::file::{Chain, Kernel, SceneFile};
 use crate::scene::Scene;
+use crate::timing::csv::field;
+use crate::timing::fingerprint::{run_id, timestamp};
+use crate::timing::{Fingerprint, PassStats, RunReport, GIT_COMMIT, RULER_COPY, VERSION};
 use metric::{compare, coverage_mask, ImageError};
 use points::SWEEP_SCHEMA_VERSION;
 use serde::{Deserialize, Serialize};
@@ -255,7 +253,7 @@ impl<'a> Session<'a> {
         )?;
         let median = |p: &PassStats| p.time.map_or(0.0, |t| t.median_ns) / 1e6;
         // The chain by the tag its passes declare (skin::TAG).
-        let is_ruler = |p: &PassStats| crate::profile::is_ruler(&p.name);
+        let is_ruler = |p: &PassStats| crate::timing::is_ruler(&p.name);
         let is_chain = |p: &PassStats| p.tags.iter().any(|t| t == crate::skin::TAG);
         Ok(Point {
             id: variant.id(),

@@ -202,7 +202,7 @@ where
     let mut groups: Vec<String> = Vec::new();
     for p in sweep.points.iter().flat_map(|p| &p.passes) {
         let g = group(&p.name);
-        if !crate::profile::is_ruler(&p.name) && !groups.contains(&g) {
+        if !crate::timing::is_ruler(&p.name) && !groups.contains(&g) {
             groups.push(g);
         }
     }
@@ -260,7 +260,7 @@ where
                 let ms = |filter: &dyn Fn(&str) -> bool| {
                     p.passes
                         .iter()
-                        .filter(|s| !crate::profile::is_ruler(&s.name) && filter(&s.name))
+                        .filter(|s| !crate::timing::is_ruler(&s.name) && filter(&s.name))
                         .map(|s| s.time.map_or(0.0, |t| t.median_ns) / 1e6)
                         .filter(|ms| ms.is_finite())
                         .sum::<f64>()
@@ -293,10 +293,10 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::{PassStats, Stats};
     use crate::scene::file::{Chain, Kernel};
     use crate::sweep::metric::ImageError;
     use crate::sweep::Variant;
+    use crate::timing::{PassStats, Stats};
 
     fn sweep(points: Vec<(f64, f64)>) -> Sweep {
         let variant = |i: usize| Variant {

@@ -12,7 +12,7 @@ use crate::gpu::{
 };
 use crate::graph::upload::{upload_texture, Readback};
 use crate::graph::{Access, Executor, FrameSync, Graph, Imported, LoadOp};
-use crate::profile::FrameReport;
+use crate::timing::FrameTiming;
 use ash::vk;
 use egui::epaint::ClippedPrimitive;
 use std::path::Path;
@@ -25,7 +25,7 @@ const FRAMES_IN_FLIGHT: usize = 2;
 pub struct Presented {
     /// The report of an earlier window frame that has completed (its `present`
     /// and `ui` passes).
-    pub report: Option<FrameReport>,
+    pub report: Option<FrameTiming>,
 }
 
 pub struct Presenter {
@@ -154,7 +154,7 @@ impl Presenter {
         let compiled = self.executor.compile(g)?;
         // No pass of the render thread's is submitted between this frame's
         // submission and its present: on lavapipe, without this, a window frame
-        // also waited behind the passes submitted meanwhile (docs/viewer.md).
+        // also waited behind the passes submitted meanwhile (docs/design/viewer.md).
         let ctx = self.ctx.clone();
         let foreground = ctx.foreground();
         let report = self.executor.submit_synced(
@@ -176,7 +176,7 @@ impl Presenter {
     }
 
     /// Waits for every frame in flight (before the window closes).
-    pub fn finish(&mut self) -> Result<Vec<FrameReport>> {
+    pub fn finish(&mut self) -> Result<Vec<FrameTiming>> {
         self.executor.finish()
     }
 }

@@ -6,10 +6,10 @@
 //! renders again when they change.
 
 use super::camera::Orbit;
-use crate::profile::FrameReport;
 use crate::render::{Screen, View};
 use crate::scene::env::EnvSource;
 use crate::scene::file::{Chain, Kernel, LightsMode, Occlusion, SceneFile, ToneCurve};
+use crate::timing::FrameTiming;
 use std::collections::VecDeque;
 
 /// Frames the timings are the median of, and the graph shows.
@@ -54,18 +54,18 @@ pub fn environments(scene_env: &EnvSource) -> Vec<(String, EnvSource)> {
 #[derive(Default)]
 pub struct Timings {
     /// Rendered frames (the skin pipeline).
-    frames: VecDeque<FrameReport>,
+    frames: VecDeque<FrameTiming>,
     /// Window frames (present, ui).
-    window: VecDeque<FrameReport>,
+    window: VecDeque<FrameTiming>,
     window_ms: VecDeque<f64>,
 }
 
 impl Timings {
-    pub fn add_frame(&mut self, report: FrameReport) {
+    pub fn add_frame(&mut self, report: FrameTiming) {
         push(&mut self.frames, report);
     }
 
-    pub fn add_window_frame(&mut self, report: FrameReport) {
+    pub fn add_window_frame(&mut self, report: FrameTiming) {
         push(&mut self.window, report);
     }
 

@@ -7,12 +7,12 @@
 
 use crate::error::Result;
 use crate::gpu::{Context, Image};
-use crate::profile::FrameReport;
 use crate::render::session::Session;
 use crate::render::{Screen, View};
 use crate::scene::camera::Camera;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
+use crate::timing::FrameTiming;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -37,7 +37,7 @@ pub struct Done {
 
 pub struct Rendered {
     pub image: Arc<Image>,
-    pub report: Option<FrameReport>,
+    pub report: Option<FrameTiming>,
     pub extracted_lights: usize,
     /// The session's views (render::session::Session::views).
     pub views: Vec<String>,
@@ -137,7 +137,7 @@ fn serve(ctx: &Arc<Context>, inbox: &Receiver<Job>, outbox: &Sender<Done>) {
     }
 }
 
-type Frame = (Arc<Image>, Option<FrameReport>, usize, bool);
+type Frame = (Arc<Image>, Option<FrameTiming>, usize, bool);
 
 /// One job on `session`, started again when it cannot take the job's settings
 /// (render::session::Session::update decides).

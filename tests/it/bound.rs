@@ -5,8 +5,8 @@ use crate::common;
 
 use dermis::gpu::{ImageDesc, Pipelines, Sampler};
 use dermis::graph::{Executor, Graph};
-use dermis::profile::{Bound, MemoryUse, RunReport, RunSetup};
 use dermis::testscene::{TestScene, HALF};
+use dermis::timing::{Bound, MemoryUse, RunReport, RunSetup};
 use std::sync::Arc;
 
 #[test]

@@ -153,7 +153,7 @@ fn render_writes_self_describing_report_trace_and_csv() {
     assert!(fp["cpu_cores"].as_u64().is_some_and(|c| c >= 1));
     assert_eq!(fp["validation"], true);
     // Enough to reproduce: the command line, when, from which sources.
-    assert_eq!(r["schema_version"], dermis::profile::SCHEMA_VERSION);
+    assert_eq!(r["schema_version"], dermis::timing::SCHEMA_VERSION);
     let args = r["command_line"].as_array().unwrap();
     assert!(args.iter().any(|a| a == "--irradiance-res"), "{args:?}");
     assert!(r["timestamp"].as_str().is_some_and(|t| t.ends_with('Z')));

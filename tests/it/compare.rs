@@ -192,7 +192,7 @@ fn scaled_pass(from: &Path, to: &Path, pass: &str, scale: f64) {
 
 /// One pass ten times as slow, 4 runs a side: the t-test on log-times calls
 /// it (the rank test cannot: 2 / C(8, 4) = 0.029 > 0.05 / 16). Ten times,
-/// not the 3× of the synthetic study (src/profile/aa_study.rs): runs of this
+/// not the 3× of the synthetic study (src/timing/aa_study.rs): runs of this
 /// tiny scene scattered ±40 % while other builds shared the cores, and 4 runs
 /// of that cannot call 3×.
 #[test]

@@ -6,8 +6,8 @@ use crate::common;
 
 use dermis::gpu::ImageDesc;
 use dermis::graph::{Clock, Executor, Graph, LoadOp};
-use dermis::profile::FrameReport;
 use dermis::testscene::{CompositePush, TestScene, HALF};
+use dermis::timing::FrameTiming;
 
 /// Not a multiple of pattern.comp's 8 × 8 workgroup: the last groups overhang.
 const W: u32 = 100;
@@ -15,7 +15,7 @@ const H: u32 = 60;
 
 /// Frames of: the test pattern (compute, W × H threads), then a full-screen
 /// triangle compositing it into a W × H attachment.
-fn frames(clock: Clock, counters: bool) -> Vec<FrameReport> {
+fn frames(clock: Clock, counters: bool) -> Vec<FrameTiming> {
     common::with_gpu(|ctx| {
         let scene = TestScene::new(ctx).unwrap();
         let mut ex = Executor::new(ctx, 2).unwrap();
@@ -45,7 +45,7 @@ fn frames(clock: Clock, counters: bool) -> Vec<FrameReport> {
     })
 }
 
-fn check(reports: &[FrameReport]) {
+fn check(reports: &[FrameTiming]) {
     assert_eq!(reports.len(), 3);
     // 8 × 8 workgroups (pattern.comp's local size): ⌈100/8⌉ × ⌈60/8⌉ = 13 × 8
     // groups of 64 invocations.

@@ -1,4 +1,4 @@
-//! The layering of `src/` (docs/architecture.md): each top-level module imports
+//! The layering of `src/` (docs/design/architecture.md): each top-level module imports
 //! only modules of lower layers, and the files inside a module import each other
 //! without circles. Reads every `crate::…` and `super::…` path in the code
 //! (comments excluded), so a future back-import fails here.
@@ -10,13 +10,14 @@ use std::path::{Path, PathBuf};
 /// its own layer's other modules or anything above.
 const LAYERS: &[&[&str]] = &[
     &["main", "cli"],
+    &["fidelity"],
     &["sweep", "viewer"],
     &["render"],
     &["post", "light"],
     &["skin"],
-    &["frame", "testscene"],
+    &["frame_inputs", "testscene"],
     &["scene", "graph"],
-    &["profile"],
+    &["timing"],
     &["gpu"],
     &["atomic", "cache"],
     &["error", "assets", "text"],
@@ -26,7 +27,7 @@ fn layer_of(module: &str) -> usize {
     LAYERS
         .iter()
         .position(|l| l.contains(&module))
-        .unwrap_or_else(|| panic!("module {module:?} is in no layer of tests/layers.rs"))
+        .unwrap_or_else(|| panic!("module {module:?} is in no layer of tests/it/layers.rs"))
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -63,12 +63,12 @@ fn reference_coverage_matches_the_gpu() {
 /// The issue's sunny case: on the scan under quarry_01 (one sun, half the map's
 /// energy), the direct term with the sun taken out as a shadowed light is at
 /// least 3× closer to the reference than SH9 alone, and within 8 % on average
-/// (docs/lighting.md, "SH9 against the reference"). The reference converges to
+/// (docs/records/2026-11-25-sh9-against-reference.md). The reference converges to
 /// 1 % here (0.5 % in the docs' table) to stay quick.
 #[test]
 fn extracted_lights_beat_sh9_alone_under_a_sunny_map() {
+    use dermis::fidelity::lighting_gap::{run, LightingOptions};
     use dermis::scene::env::EnvSource;
-    use dermis::sweep::lighting::{run, LightingOptions};
     let opts = LightingOptions {
         scene: scene_by_name(None).unwrap(),
         environments: vec![EnvSource::File(dermis::assets::path(
@@ -106,12 +106,12 @@ fn extracted_lights_beat_sh9_alone_under_a_sunny_map() {
 /// (skin::reference, checked against closed forms in its unit tests): every
 /// face region of the landmark masks is populated, and the chain (full and
 /// adaptive) is close to the reference over the face, the seams and the mesh.
-/// The docs' figures (docs/skin.md, "Exact diffusion") come from 1024².
+/// The docs' figures (docs/records/2026-11-26-exact-diffusion.md) come from 1024².
 #[test]
 fn texture_space_diffusion_against_the_exact_reference() {
+    use dermis::fidelity::diffusion_gap::{run, table, DiffusionOptions};
     use dermis::scene::file::Chain;
     use dermis::skin::specular::REGION_NAMES;
-    use dermis::sweep::diffusion::{run, table, DiffusionOptions};
     let mut scene = scene_by_name(None).unwrap();
     scene.render.irradiance_resolution = 256;
     (scene.render.width, scene.render.height) = (48, 60);
@@ -166,8 +166,8 @@ fn texture_space_diffusion_against_the_exact_reference() {
 /// with transmission on and off, while the chain's is not.
 #[test]
 fn the_exact_reference_leaves_out_the_chains_transmitted_light() {
+    use dermis::fidelity::diffusion_gap::{run, DiffusionOptions};
     use dermis::scene::file::Chain;
-    use dermis::sweep::diffusion::{run, DiffusionOptions};
     let read = |transmission: f32| {
         let mut scene = scene_by_name(None).unwrap();
         scene.render.irradiance_resolution = 256;
@@ -203,7 +203,7 @@ fn the_exact_reference_leaves_out_the_chains_transmitted_light() {
 /// visibility V = image / image without shadows on both sides, the mean offset
 /// of the V = ½ line (positive: dermis's edge lies inside the reference's
 /// shadow) and the width of the 10–90 % penumbra, in mm on the cheek, for a
-/// hard light and one 3° across, at two shadow-map resolutions (docs/lighting.md,
+/// hard light and one 3° across, at two shadow-map resolutions (docs/design/lighting.md,
 /// "The nose's shadow edge"). Issue 22's target (within 0.25 mm, penumbra within
 /// 25 %) is not met at the default 2048²; the assertions hold what a map of the
 /// mesh's bounding sphere gives, that a finer map comes closer, and the soft

@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use dermis::frame::MeshBuffers;
+use dermis::frame_inputs::MeshBuffers;
 use dermis::gpu::{Context, ImageDesc, Pipelines, Sampler};
 use dermis::graph::upload::upload_texture;
 use dermis::graph::upload::Readback;

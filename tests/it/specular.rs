@@ -691,7 +691,7 @@ fn prefiltered_environment_matches_brute_force_integration() {
     let e = prefilter_errors(&dir, "venice_sunset_1k.hdr", LightsMode::Auto);
     assert!(e[e.len() / 2] < 0.01 && e[e.len() - 1] < 0.05, "{e:?}");
     // Tiny, very bright lamps: 1024 samples still miss or smear them near
-    // their direction (docs/lighting.md); the bulk stays close.
+    // their direction (docs/design/lighting.md); the bulk stays close.
     let e = prefilter_errors(&dir, "royal_esplanade_1k.hdr", LightsMode::Count(0));
     assert!(e[e.len() / 2] < 0.02 && e[e.len() * 9 / 10] < 0.2, "{e:?}");
     // Taken out as lights, what is left prefilters nearly as well as the sunset.
@@ -699,7 +699,7 @@ fn prefiltered_environment_matches_brute_force_integration() {
     assert!(e[e.len() / 2] < 0.01 && e[e.len() - 1] < 0.1, "{e:?}");
 }
 
-/// The calibration of docs/skin.md: under a uniform white sky of radiance 1
+/// The calibration of docs/design/skin.md: under a uniform white sky of radiance 1
 /// (occlusion off) the scan's specular is 5–10 % of the light its face
 /// reflects (the paper: skin reflects ~9 % specularly; d'Eon ~6 %; a
 /// dielectric microfacet surface with F0 = 0.028 gives ~10 %). It was 0.6 %.

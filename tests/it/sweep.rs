@@ -133,7 +133,7 @@ fn the_adaptive_chain_stays_within_one_percent_of_the_full_chain() {
     // the irradiance evaluated per pixel, the full chain's a texture of 0.6 mm
     // texels: 0.84 % apart (under 0.5 %, this test's bound before, when both
     // read the texture). Against the sweep's 4096² reference the adaptive
-    // chain is the closer of the two (docs/performance.md, "The unblurred
+    // chain is the closer of the two (docs/records/2026-11-26-unblurred-levels-per-pixel.md, "The unblurred
     // levels per pixel").
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes/close-up-lights.toml");
     let mut file = load_scene(&path).unwrap();

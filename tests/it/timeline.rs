@@ -6,12 +6,12 @@ use crate::common;
 
 use dermis::graph::upload::Readback;
 use dermis::graph::{Clock, Executor, Graph};
-use dermis::profile::FrameReport;
 use dermis::testscene::TestScene;
+use dermis::timing::FrameTiming;
 
 /// The frames, whether the device calibrates, and how far its GPU times on
 /// the host clock may be off (ns; 0 on host fences).
-fn frames(clock: Clock) -> (Vec<FrameReport>, bool, f64) {
+fn frames(clock: Clock) -> (Vec<FrameTiming>, bool, f64) {
     common::with_gpu(|ctx| {
         let (w, h) = (96, 64);
         let scene = TestScene::new(ctx).unwrap();
@@ -34,7 +34,7 @@ fn frames(clock: Clock) -> (Vec<FrameReport>, bool, f64) {
 /// its last wait ending at or after its last pass's end — within `slack` ns,
 /// the calibration's uncertainty (the driver's deviation and the length of the
 /// calibrating call, which a loaded machine stretches).
-fn check(reports: &[FrameReport], slack: f64) {
+fn check(reports: &[FrameTiming], slack: f64) {
     assert_eq!(reports.len(), 4);
     for r in reports {
         let start = r

@@ -5,10 +5,10 @@ use crate::common;
 
 use dermis::graph::upload::Readback;
 use dermis::graph::{Clock, Executor, Graph};
-use dermis::profile::FrameReport;
 use dermis::testscene::TestScene;
+use dermis::timing::FrameTiming;
 
-fn frames(clock: Clock) -> Vec<FrameReport> {
+fn frames(clock: Clock) -> Vec<FrameTiming> {
     common::with_gpu(|ctx| {
         let (w, h) = (96, 64);
         let scene = TestScene::new(ctx).unwrap();
@@ -26,7 +26,7 @@ fn frames(clock: Clock) -> Vec<FrameReport> {
     })
 }
 
-fn check(reports: &[FrameReport], clock: &str) {
+fn check(reports: &[FrameTiming], clock: &str) {
     assert_eq!(reports.len(), 4);
     for (i, r) in reports.iter().enumerate() {
         assert_eq!(r.frame, i as u64, "reports come back in frame order");

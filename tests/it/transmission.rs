@@ -1,4 +1,4 @@
-//! Light through thin skin (translucent shadow maps; docs/skin.md,
+//! Light through thin skin (translucent shadow maps; docs/records/2026-11-26-transmission.md,
 //! "Transmission") on an analytic backlit slab: a flat box d mm thick, a light
 //! straight behind it, the camera in front. The front face's transmitted
 //! radiance must be T(d)·E·albedo/π, with T the CPU profile's transmittance
@@ -287,7 +287,7 @@ fn transmission_zero_or_a_light_in_front_adds_nothing() {
         let with = render(ctx, &scene(1.0, front, 1.0), "final");
         let without = render(ctx, &scene(1.0, front, 0.0), "final");
         // The lit face's own radiance, E·cos θ·albedo/π: what the same albedo
-        // and readback give without the transmission (printed for docs/skin.md).
+        // and readback give without the transmission (printed for docs/records/2026-11-26-transmission.md).
         let lit = E * Vec3::new(0.2, 0.1, 1.0).normalize().z * ALBEDO / PI;
         println!(
             "front-lit radiance / E·cos θ·albedo/π = {}",

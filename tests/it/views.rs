@@ -26,7 +26,7 @@ fn scene() -> Scene {
 
 /// The fewest distinct colours a view of the head must show: the region ids
 /// are ten colours and the background; the light through thin skin lies on a
-/// few pixels only (the far sides of thin parts: docs/skin.md, "Only from a far
+/// few pixels only (the far sides of thin parts: docs/records/2026-11-26-transmission.md, "Only from a far
 /// side"), so it must only not be blank; the rest vary smoothly.
 fn least_colours(view: &View) -> usize {
     match view {

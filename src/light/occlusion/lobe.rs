@@ -1,6 +1,6 @@
 //! The environment's specular occlusion: per vertex the SH of the visibility
 //! itself (not cosine-weighted), read through a lobe about the mirror direction
-//! (docs/skin.md, "The specular against the reference's").
+//! (docs/records/2026-11-26-path-tracer-cycles.md, "The specular against the reference's").
 //!
 //! # What is baked
 //! ```text

@@ -7,7 +7,7 @@
 
 use super::transfer::Transfer;
 use crate::error::{Error, Result};
-use crate::frame::{MeshBuffers, Vertex};
+use crate::frame_inputs::{MeshBuffers, Vertex};
 use crate::gpu::{Buffer, Context, GraphicsDesc, ImageDesc, MemoryLocation, Pipeline, Sampler};
 use crate::graph::upload::upload_buffer;
 use crate::graph::{Access, Executor, Graph, Imported, LoadOp};

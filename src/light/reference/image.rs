@@ -16,7 +16,7 @@
 //!   environment bilinearly sampled along the ray through the far plane,
 //!   `env_dir`-rotated, × intensity, alpha 0 (alpha is the coverage); without:
 //!   (0, 0, 0, 0);
-//! - the first `frame::MAX_LIGHTS` lights, as the GPU uploads.
+//! - the first `frame_inputs::MAX_LIGHTS` lights, as the GPU uploads.
 //!
 //! The albedo is read at mip level 0 where the GPU filters trilinearly across
 //! its mips, so pixels covering many texels differ by that filtering.
@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use super::integrate::{Integrator, Settings};
 use super::texture;
 use crate::error::{Error, Result};
-use crate::frame::MAX_LIGHTS;
+use crate::frame_inputs::MAX_LIGHTS;
 use crate::light::occlusion::Hit;
 use crate::scene::env::direction_to_uv;
 use crate::scene::texture::Texture;

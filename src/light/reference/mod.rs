@@ -2,7 +2,7 @@
 //! Monte Carlo integration of the environment map (multiple importance
 //! sampling of the map and the cosine lobe, shadow rays against the mesh) and
 //! the explicit lights, sampled until the estimate's standard error is below
-//! 0.5 %. docs/lighting.md, "Reference integrator".
+//! 0.5 %. docs/design/lighting.md, "Reference integrator".
 //!
 //! - [`per_vertex`]: E at every vertex of a mesh;
 //! - [`render_view`]: `albedo/π · E` per pixel through the scene's camera, the

@@ -1,6 +1,6 @@
 //! Bilinear lookups as the GPU's samplers make them at mip level 0: texel
 //! centres at `(i + ½)/size`, clamp to edge in u and v (`gpu::Sampler::clamped`,
-//! `frame/samplers.rs`). sRGB maps are decoded to linear per texel before
+//! `frame_inputs/samplers.rs`). sRGB maps are decoded to linear per texel before
 //! filtering, as an `_SRGB` format is sampled.
 
 use glam::{Vec2, Vec3, Vec4};

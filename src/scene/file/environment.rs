@@ -39,7 +39,7 @@ impl Default for Environment {
 }
 
 /// Most lights `light::extract` takes out of one environment map: each costs a
-/// shadow map per frame, and the CC0 maps need at most 4 (docs/lighting.md).
+/// shadow map per frame, and the CC0 maps need at most 4 (docs/design/lighting.md).
 pub const MAX_EXTRACTED_LIGHTS: usize = 8;
 
 /// How many bright sources are extracted from the environment map as lights:

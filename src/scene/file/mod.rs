@@ -1,5 +1,5 @@
 //! The TOML scene file: which mesh, maps, lighting, camera, skin parameters and
-//! render settings to use. Every field is optional; `docs/scene-format.md` lists
+//! render settings to use. Every field is optional; `docs/reference/scene-format.md` lists
 //! each one with its unit, default, valid range and the source of the default.
 //!
 //! [`load_scene`] parses, checks every value ([`SceneFile::validate`]) and resolves
@@ -35,7 +35,7 @@ pub use skin::{
 };
 
 // ---------------------------------------------------------------------------
-// The scene description. Field defaults are documented in docs/scene-format.md.
+// The scene description. Field defaults are documented in docs/reference/scene-format.md.
 
 /// A parsed scene. `SceneFile::default()` is the built-in head under the `sky`
 /// environment with every other setting at its default.

@@ -7,7 +7,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use super::{finite, in_range, non_negative};
 
 /// The tone curve from exposed radiance to display values in [0, 1]
-/// (post::tonemap, docs/post.md).
+/// (post::tonemap, docs/design/post.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum ToneCurve {
@@ -59,7 +59,7 @@ impl<'de> Deserialize<'de> for Gamma {
 }
 
 /// How the irradiance pass reaches the texels of the UV layout
-/// (skin::irradiance; docs/performance.md, "The irradiance pass in compute").
+/// (skin::irradiance; docs/records/2026-11-27-compute-irradiance.md, "The irradiance pass in compute").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum IrradianceShading {

@@ -9,7 +9,7 @@ use super::{in_range, non_negative, positive};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Kernel {
-    /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in docs/skin.md, "Blur kernels").
+    /// d'Eon's 7 taps at -3σ..3σ (GPU Gems 3 §14.5; weights in docs/design/skin.md, "Blur kernels").
     Deon7,
     /// Wider, exactly normalised Gaussian taps (reference quality).
     Accurate,
@@ -85,7 +85,7 @@ pub struct Skin {
     /// section II.B); off: one texels-per-mm constant for the whole mesh.
     pub stretch_correction: bool,
     /// Blur along the surface metric of the UVs, not only their scale: the V
-    /// pass steps along the surface perpendicular of ∂P/∂u (docs/skin.md,
+    /// pass steps along the surface perpendicular of ∂P/∂u (docs/records/2026-11-26-shear-aware-diffusion.md,
     /// "Shear-aware diffusion"); off: along v, as if the UV axes met at right
     /// angles on the surface.
     pub shear_correction: bool,
@@ -96,7 +96,7 @@ pub struct Skin {
     /// (the paper's "blurring amount"; 0: unblurred).
     pub blur_amount: f32,
     /// Scale on the light transmitted through thin skin from shadowed lights
-    /// behind it (translucent shadow maps, docs/skin.md "Transmission"; ≥ 0,
+    /// behind it (translucent shadow maps, docs/records/2026-11-26-transmission.md "Transmission"; ≥ 0,
     /// 0: off).
     pub transmission: f32,
     /// The medium the profile, the transmission and the specular follow

@@ -1,4 +1,4 @@
-//! The scene file's tests: parsing, validation, docs/scene-format.md's examples.
+//! The scene file's tests: parsing, validation, docs/reference/scene-format.md's examples.
 
 use super::*;
 use crate::scene::env::SkyParams;
@@ -30,9 +30,9 @@ fn repo_root() -> PathBuf {
     file.ancestors().nth(4).map(Path::to_path_buf).unwrap()
 }
 
-/// The ```toml blocks of docs/scene-format.md.
+/// The ```toml blocks of docs/reference/scene-format.md.
 fn doc_examples() -> Vec<String> {
-    let doc = repo_root().join("docs/scene-format.md");
+    let doc = repo_root().join("docs/reference/scene-format.md");
     let text = std::fs::read_to_string(&doc).unwrap();
     let mut blocks = Vec::new();
     let mut current: Option<String> = None;
@@ -526,7 +526,7 @@ fn doc_examples_parse_and_validate() {
     let examples = doc_examples();
     assert!(
         examples.len() >= 2,
-        "docs/scene-format.md has no ```toml examples"
+        "docs/reference/scene-format.md has no ```toml examples"
     );
     for (i, text) in examples.iter().enumerate() {
         if let Err(e) = parse(text) {

@@ -1,7 +1,7 @@
 //! The exact-diffusion reference: the skin profile convolved with the
 //! irradiance over the surface in 3-D, by Euclidean distance (Jensen & Buhler
 //! 2002, "A Rapid Hierarchical Rendering Technique for Translucent Materials"),
-//! the yardstick for the texture-space chain (docs/skin.md, "Exact diffusion").
+//! the yardstick for the texture-space chain (docs/records/2026-11-26-exact-diffusion.md, "Exact diffusion").
 //!
 //! At a point x, per Gaussian k of the profile,
 //! `M_k(x) = ∫ G(v_k, |x − y|) E(y) dA(y)` and the profile's reach
@@ -72,7 +72,7 @@ pub struct Scattered {
     /// [`AIR_ELEVATION_DEG`] above x's tangent plane (across a fold, a crease,
     /// the gap behind an ear), where light inside the skin goes the longer way
     /// round. Without it, M_k is a lower bound of the light there; with it an
-    /// upper bound (docs/skin.md, "Exact diffusion").
+    /// upper bound (docs/records/2026-11-26-exact-diffusion.md, "Exact diffusion").
     pub through_air: Vec<Vec3>,
 }
 
