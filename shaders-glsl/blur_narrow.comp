@@ -1,7 +1,7 @@
 #version 460
 // One Gaussian of the skin chain that spans about a texel or less (skin/chain.rs,
-// Stencil), both directions in one pass, source and destination of one size
-// (issue 24). Its covariance in source texels is Σ = σ²·U·Uᵀ, U = [[r, b], [0, g]]
+// Stencil), both directions in one pass, source and destination of one size.
+// Its covariance in source texels is Σ = σ²·U·Uᵀ, U = [[r, b], [0, g]]
 // the stretch map's factor (stretch.frag: the U pass steps (r, 0) and the V pass
 // (b, g) texels per mm, so this is the two passes' covariance). The stencil's
 // weights have exactly that covariance and are read with bilinear taps: a tap at
@@ -24,7 +24,7 @@
 // moment needs more than the product holds.
 //
 // HALF (with FIVE only): the source has twice the destination's side (a level
-// that halves its resolution, issue 24). A destination texel's centre is a
+// that halves its resolution). A destination texel's centre is a
 // source texel corner, so a tap at o destination texels reads source texels at
 // 2o ± ½ and has second moment ((n − ½)² + 2n·f)/4 with 2o + ½ = n + f: the
 // centre tap is the 2×2 box, of variance BOX. The stencil is the 5×5 of Σ − BOX

@@ -2,7 +2,7 @@
 // The irradiance pass's surface terms, which no light changes: drawn once per
 // render over the same UV raster as irradiance.frag and the texel map
 // (texel_map.vert), and read back texel for texel by irradiance.frag or
-// irradiance.comp (skin/irradiance.rs; issue 24). Two RGBA16 UNORM targets
+// irradiance.comp (skin/irradiance.rs). Two RGBA16 UNORM targets
 // (1.5·10⁻⁵ steps over [0, 1], finer than half floats there): the normal-mapped
 // shading normal, octahedral (common/octahedral.glsl), with the specular's (ρs,
 // m); and the pre-scatter albedo^mix (GPU Gems 3 §14.5) with the share of the

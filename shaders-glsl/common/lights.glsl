@@ -292,7 +292,7 @@ float stored_hard_visibility(int i) {
 
 // Fraction of light i (without an angular size) that reaches x (surface normal
 // ng) from direction l: 3×3 bilinear PCF, its taps spread over the shaded
-// sample's footprint in the map (issue 22: the penumbra follows the light's
+// sample's footprint in the map (the penumbra follows the light's
 // size, here none, not the map's texel). Taps d texels apart have variance
 // 2d²/3 plus a bilinear tap's 1/6; the footprint's box of f texels, f²/12:
 // d = √(f²/8 − ¼), from 0 (one bilinear comparison's worth) to 1 texel (the

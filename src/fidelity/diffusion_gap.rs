@@ -33,10 +33,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Texels within this distance (mm) of a UV seam are the seam region (issue 22).
+/// Texels within this distance (mm) of a UV seam are the seam region.
 pub const SEAM_MM: f32 = 2.0;
 /// Where |D_ref − E| > this share of D_ref, scattering changes the light
-/// visibly: shadow edges, the terminator (issue 22's "more than 20 %").
+/// visibly: shadow edges, the terminator.
 pub const SCATTERING_CHANGE: f32 = 0.2;
 /// Below this coverage a level's texel has no value of its own.
 const MIN_COVERAGE: f32 = 1e-3;

@@ -8,7 +8,7 @@
 //! [`MAX_RESOLUTION`]², whatever the screen. The other shadowed lights' 3×3 PCF
 //! is drawn the same way at the irradiance resolution (`hard_visibility`), for
 //! the irradiance pass alone, which reads it texel for texel: the same values,
-//! in 8-bit steps, once per lighting instead of every frame (issue 24).
+//! in 8-bit steps, once per lighting instead of every frame.
 
 use crate::error::Result;
 use crate::frame_inputs::{FrameInputs, ShaderVariant, Vertex};

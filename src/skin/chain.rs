@@ -6,7 +6,7 @@
 //! narrower than [`SKIP_SIGMA_TEXELS`] (d'Eon & Luebke §14.5 suggest it for the
 //! first term). docs/design/cost-model.md shows what it costs and how far it is off.
 //! Either way a level whose blur spans at most [`Stencil::Five`]'s σ in texels
-//! of its source's resolution is blurred in one pass instead of two (issue 24);
+//! of its source's resolution is blurred in one pass instead of two;
 //! so is a level that halves its source's side, with the 5×5 stencil, where
 //! its σ spans at most that in texels of its own resolution beyond the 2×2 box
 //! its centre tap reads.

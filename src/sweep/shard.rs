@@ -581,7 +581,7 @@ mod tests {
         ];
         assert_eq!(shard_of(Some("auto"), &list), (3, 3, Mode::Hash));
         // A list naming tasks past the total (--array=1,4,9 with 3 shards):
-        // every task refuses, task 1 too, so none renders (issue 45, item 4).
+        // every task refuses, task 1 too, so none renders.
         for id in ["1", "4", "9"] {
             let env = [
                 ("SLURM_ARRAY_TASK_ID", id),
