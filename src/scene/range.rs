@@ -158,10 +158,11 @@ pub fn pre_exposure(
     let lighting = power_of_two_for(total).ok_or_else(|| {
         format!(
             "the lighting reaches an irradiance of {} on the mesh (environment {} × \
-             environment.intensity = {intensity}, and the lights): no power of two within \
+             environment.intensity = {:e}, and the lights): no power of two within \
              2^±126 brings it into what half floats hold",
             fmt(total),
-            file.environment.source
+            file.environment.source,
+            file.environment.intensity
         )
     })?;
     let map = power_of_two_for(env_irradiance).ok_or_else(|| {
@@ -174,8 +175,9 @@ pub fn pre_exposure(
     let p = PreExposure { lighting, map };
     if file.render.skybox && intensity * peak * f64::from(lighting) > f64::from(HALF_MAX) {
         log::info!(
-            "environment: its brightest texel ({peak:.4e}) × environment.intensity ({intensity}) \
-             × pre-exposure {lighting} exceeds half-float's {HALF_MAX}: the skybox saturates there"
+            "environment: its brightest texel ({peak:.4e}) × environment.intensity ({}) \
+             × pre-exposure {lighting} exceeds half-float's {HALF_MAX}: the skybox saturates there",
+            file.environment.intensity
         );
     }
     if lighting != 1.0 || map != 1.0 {
@@ -305,5 +307,30 @@ mod tests {
         file.environment.intensity = 1e-30;
         let p = pre_exposure(&file, &env, &[], &mesh).unwrap();
         assert_eq!(p.ev(), 102.0);
+    }
+
+    #[test]
+    fn light_no_normal_power_of_two_brings_into_range_is_refused_naming_it() {
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO],
+            ..Mesh::default()
+        };
+        let env = EnvMap::uniform(Vec3::ONE, 64, 32);
+        let mut file = SceneFile::default();
+        // π·1.01·1e-38 ≈ 3.2e-38: 16 over it is 2^129, past f32's 2^127.
+        file.environment.intensity = 1e-38;
+        let e = pre_exposure(&file, &env, &[], &mesh).unwrap_err();
+        assert!(
+            e.starts_with("the lighting reaches an irradiance of 3.1751e-38")
+                && e.contains("environment.intensity = 1e-38")
+                && e.contains("no power of two within 2^±126"),
+            "{e}"
+        );
+        // The map's own texels: 1e-38 of radiance, × an intensity that brings
+        // the lighting into range.
+        file.environment.intensity = 1e30;
+        let faint = EnvMap::uniform(Vec3::splat(1e-38), 64, 32);
+        let e = pre_exposure(&file, &faint, &[], &mesh).unwrap_err();
+        assert!(e.starts_with("environment sky"), "{e}");
     }
 }
