@@ -1,5 +1,5 @@
 #!/bin/bash
-# The real-GPU measurements of docs/design/cost-model.md ("On a real GPU"): per-pass
+# The real-GPU measurements of docs/records/2026-11-26-h200.md: per-pass
 # GPU timestamps of the default scene and the lit close-up, an interleaved
 # comparison with a base build, the irradiance pass's raster and compute
 # formulations side by side, and both sweeps. Run from the repository root:
