@@ -117,6 +117,17 @@ impl<'g> SimplePass<'g> {
         self.bind(Bound::Storage(r))
     }
 
+    /// The next binding: a graph image read with `imageLoad` and written with
+    /// `imageStore` in place (compute only).
+    pub fn load_store(mut self, image: &mut ImageHandle) -> Self {
+        if !self.compute() {
+            self.errors
+                .push("storage-image writes are declared for compute passes only".into());
+        }
+        let r = self.pass.write(image, Access::ComputeStorageReadWrite);
+        self.bind(Bound::Storage(r))
+    }
+
     /// The next binding: a graph storage buffer, read.
     pub fn read_buffer(mut self, buffer: &BufferHandle) -> Self {
         let access = if self.compute() {

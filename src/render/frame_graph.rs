@@ -35,6 +35,7 @@ use crate::scene::texture::Texture;
 use crate::scene::{LightSource, Scene};
 use crate::skin::blur::BlurChain;
 use crate::skin::chain::{self, Level};
+use crate::skin::fold::{FoldPass, FoldTerm};
 use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::specular;
@@ -249,6 +250,8 @@ struct Passes {
     irradiance: IrradiancePass,
     translucent: TranslucentPass,
     blur: BlurChain,
+    /// `skin.fold_correction`: the chain's levels corrected where the skin folds.
+    fold: Option<FoldPass>,
     shade: ShadePass,
     shadow: ShadowPass,
     visibility: VisibilityPass,
@@ -286,6 +289,14 @@ impl Passes {
             )?,
             irradiance: IrradiancePass::new(p, variant, res, scene.file.render.irradiance_shading)?,
             blur: BlurChain::new(p, &skin.kernel, s.linear.clone(), skin.shear_correction)?,
+            fold: match skin.fold_correction {
+                true => {
+                    let cache = crate::cache::default_cache_dir();
+                    let term = FoldTerm::load_or_compute(&scene.mesh, levels, res, &cache);
+                    Some(FoldPass::new(p, &term, s.nearest.clone())?)
+                }
+                false => None,
+            },
             shade: ShadePass::new(
                 p,
                 variant,
@@ -637,7 +648,9 @@ impl Frame {
         if self.ruler {
             ruler::passes(g, &self.pipelines, &inputs.samplers.nearest, &irradiance)?;
         }
-        let blurred = p.blur.chain(g, &irradiance, &stretch, &self.levels);
+        let blurred = p
+            .blur
+            .chain(g, &irradiance, &stretch, &self.levels, p.fold.as_ref());
         let specular_env = p.prefilter.pass(g, &inputs.lighting_env);
         // Per Gaussian its RGB weight and variance (mm²): the transmittance.
         let profile = std::array::from_fn(|i| {

@@ -165,6 +165,10 @@ overrides! {
     /// and v, their scale only), replacing `skin.shear_correction`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     shear_correction: bool => skin.shear_correction, example "off";
+    /// Correct the blur levels where the skin folds or a UV seam cuts it
+    /// (a precomputed 3-D term), replacing `skin.fold_correction`.
+    #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
+    fold_correction: bool => skin.fold_correction, example "on";
     /// The numbered UV checker as the albedo, replacing `textures.test_texture`.
     #[arg(value_name = "on|off", hide_possible_values = true, value_parser = on_off())]
     test_texture: bool => textures.test_texture, example "on";

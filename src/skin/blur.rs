@@ -13,6 +13,7 @@
 //! pull the gutter's black into chart borders, however wide the kernel.
 
 use super::chain::{Level, Stencil};
+use super::fold::FoldPass;
 use super::profile::Kernel;
 use super::UV_FORMAT;
 use crate::error::{Error, Result};
@@ -101,13 +102,14 @@ impl BlurChain {
 
     /// The blurred levels `levels` plans, in order (a level without a σ adds
     /// none: see [`BlurChain::select`]); level k's taps are spaced by
-    /// `stretch[k − 1]`.
+    /// `stretch[k − 1]`; with `fold`, each level's fold term follows its blur.
     pub fn chain(
         &self,
         g: &mut Graph,
         irradiance: &ImageHandle,
         stretch: &[ImageHandle],
         levels: &[Level],
+        fold: Option<&FoldPass>,
     ) -> Vec<ImageHandle> {
         let mut out: Vec<ImageHandle> = Vec::new();
         for (k, level) in levels.iter().enumerate() {
@@ -124,6 +126,9 @@ impl BlurChain {
                 self.narrow(g, &name, (src, &stretch[k]), sigma, stencil, &mut dst);
             } else {
                 self.gaussian(g, &name, src, &stretch[k], sigma, &mut dst);
+            }
+            if let Some(fold) = fold {
+                fold.pass(g, k, src, &mut dst);
             }
             out.push(dst);
         }

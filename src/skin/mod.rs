@@ -6,6 +6,7 @@ pub mod blur;
 pub mod chain;
 pub mod falloff;
 pub mod fit;
+pub mod fold;
 pub mod irradiance;
 pub mod medium;
 pub mod medium_tables;
@@ -75,6 +76,9 @@ pub struct SkinSettings {
     /// perpendicular of ∂P/∂u (skin::stretch::StretchTensor); off: the diagonal
     /// only, u then v.
     pub shear_correction: bool,
+    /// Correct the chain's levels where the skin comes back within the
+    /// profile's reach through the tissue (skin::fold).
+    pub fold_correction: bool,
     /// The medium the profile was fitted to, and its tables; `None` for
     /// `deon2007` (the paper's Gaussians).
     pub medium: Option<MediumSkin>,
@@ -170,6 +174,7 @@ impl SkinSettings {
             stretch_correction: skin.stretch_correction,
             transmission: skin.transmission,
             shear_correction: skin.shear_correction,
+            fold_correction: skin.fold_correction,
             medium,
             reference_profile,
         })

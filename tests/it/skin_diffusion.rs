@@ -79,7 +79,7 @@ fn chain_with(
             None,
         );
         let st = stretch.pass(&mut g, &buffers, &blur);
-        let blurred = blur.chain(&mut g, &input, &st, &plan);
+        let blurred = blur.chain(&mut g, &input, &st, &plan, None);
         let levels = BlurChain::select(&input, &blurred, &plan);
         for (level, buf) in levels.iter().zip(&readbacks) {
             buf.image_pass(&mut g, level);

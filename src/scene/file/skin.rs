@@ -89,6 +89,11 @@ pub struct Skin {
     /// "Shear-aware diffusion"); off: along v, as if the UV axes met at right
     /// angles on the surface.
     pub shear_correction: bool,
+    /// Add, per blurred level, the light the texture-space chain cannot carry
+    /// where the skin comes back within the profile's reach through the tissue
+    /// (seams, squeezed UVs, folds), precomputed per mesh (skin::fold); off:
+    /// the chain alone.
+    pub fold_correction: bool,
     /// Scale on every variance of the profile (the paper's "blurring width";
     /// 0: no blur).
     pub blur_width: f32,
@@ -116,6 +121,7 @@ impl Default for Skin {
             interreflection: true,
             stretch_correction: true,
             shear_correction: true,
+            fold_correction: false,
             blur_width: 1.0,
             blur_amount: 1.0,
             transmission: 1.0,

@@ -78,6 +78,20 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// Calls `f` with the id of every item in the cells within `radius` (≤ the
+    /// grid's) of `x`: an item in several cells, more than once; for points,
+    /// each once, unsorted, without [`Grid::near`]'s sort.
+    pub fn each_near(&self, x: Vec3, radius: f32, mut f: impl FnMut(u32)) {
+        let r = Vec3::splat(radius);
+        self.each_cell(x - r, x + r, |c| {
+            for &id in &self.ids[self.starts[c] as usize..self.starts[c + 1] as usize] {
+                f(id)
+            }
+        });
+    }
+}
+
 /// Calls `f` with the index of every cell the box (a, b) overlaps.
 fn grid_cells(origin: Vec3, cell: f32, dims: IVec3, a: Vec3, b: Vec3, mut f: impl FnMut(usize)) {
     let index = |p: Vec3| {

@@ -14,6 +14,8 @@ pub struct Texel {
     pub position: Vec3,
     /// Interpolated, normalised vertex normal.
     pub normal: Vec3,
+    /// The triangle (index into the triangles of `indices`) it lies in.
+    pub triangle: u32,
 }
 
 /// The texels of an N × N target (`resolution`) whose centres fall in a
@@ -31,7 +33,7 @@ pub fn texels(
     let stride = stride.max(1) as usize;
     let mut taken = vec![false; n * n];
     let mut out = Vec::new();
-    for t in indices.chunks_exact(3) {
+    for (triangle, t) in indices.chunks_exact(3).enumerate() {
         let t = [t[0], t[1], t[2]].map(|i| i as usize);
         let q = t.map(|i| uvs[i] * resolution as f32);
         let area = (q[1] - q[0]).perp_dot(q[2] - q[0]);
@@ -60,6 +62,7 @@ pub fn texels(
                     uv: c / resolution as f32,
                     position: mix3(positions),
                     normal: mix3(normals).normalize_or_zero(),
+                    triangle: triangle as u32,
                 });
             }
         }
