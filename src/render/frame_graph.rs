@@ -410,6 +410,7 @@ impl Frame {
         let tables = SpecularTables::new(
             ctx,
             &skin.regions,
+            specular::F0_SKIN,
             &scene.regions,
             s.linear.clone(),
             s.nearest.clone(),

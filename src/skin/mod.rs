@@ -153,7 +153,7 @@ impl SkinSettings {
         });
         if medium.as_ref().is_some_and(MediumSkin::boundary_specular) {
             for r in &mut regions {
-                r.rho_s = specular::boundary_rho_s(r.m);
+                r.rho_s = specular::boundary_rho_s(r.m, specular::F0_SKIN);
             }
         }
         Ok(Self {

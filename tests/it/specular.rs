@@ -20,7 +20,7 @@ use dermis::scene::mesh::Mesh;
 use dermis::scene::texture::{Encoding, Texture};
 use dermis::scene::{Light, LightSource, Scene};
 use dermis::skin::specular::{
-    hemispherical_albedo, ks_brdf, map_rho_s, specular_albedo, DEFAULT_M, DEFAULT_RHO_S,
+    hemispherical_albedo, ks_brdf, map_rho_s, specular_albedo, DEFAULT_M, DEFAULT_RHO_S, F0_SKIN,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -219,7 +219,7 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
                 // Stay away from the silhouette.
                 (n.dot(v) >= 0.3).then(|| {
                     let (l, e) = light.at(p);
-                    ks_brdf(n, l, v, DEFAULT_M, rho_s()) * e.x
+                    ks_brdf(n, l, v, DEFAULT_M, rho_s(), F0_SKIN) * e.x
                 })
             })
             .collect();
@@ -440,11 +440,12 @@ fn soft_shadows_follow_the_source_size() {
     );
 }
 
-/// A(cos θ, m) by the CPU quadrature at 257 angles, interpolated linearly: A
-/// is smooth in cos θ, and the quadrature is too slow to call per texel.
-fn specular_albedo_table() -> impl Fn(f32) -> f32 {
+/// A(cos θ, m) at Schlick F0 `f0` by the CPU quadrature at 257 angles,
+/// interpolated linearly: A is smooth in cos θ, and the quadrature is too slow
+/// to call per texel.
+fn specular_albedo_table(f0: f32) -> impl Fn(f32) -> f32 {
     let table: Vec<f32> = (0..=256)
-        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M))
+        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M, f0))
         .collect();
     move |c: f32| {
         let x = c.clamp(0.0, 1.0) * 256.0;
@@ -459,7 +460,7 @@ fn shadow_maps_shadow_the_texture_space_irradiance() {
     let img = render(&s.scene, View::named("irradiance"));
     let res = s.scene.file.render.irradiance_resolution as usize;
     let mix = s.scene.file.skin.mix;
-    let albedo = specular_albedo_table();
+    let albedo = specular_albedo_table(F0_SKIN);
     // The big sphere covers the left half of the texture.
     let mut points = Vec::new();
     let expected: Vec<Option<f32>> = (0..res * res)
@@ -513,7 +514,7 @@ fn irradiance_at_the_uv_raster(shading: IrradianceShading) {
     s.file.render.irradiance_shading = shading;
     let img = render(&s, View::named("irradiance"));
     let res = s.file.render.irradiance_resolution as usize;
-    let (albedo, mix) = (specular_albedo_table(), s.file.skin.mix);
+    let (albedo, mix) = (specular_albedo_table(F0_SKIN), s.file.skin.mix);
     let m = &s.mesh;
     let mut expected = vec![None; res * res];
     for t in m.indices.chunks_exact(3) {
@@ -569,7 +570,7 @@ fn environment_specular_is_exact_under_a_constant_environment() {
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            (cos >= 0.3).then(|| rho_s() * specular_albedo(cos, DEFAULT_M) * radiance)
+            (cos >= 0.3).then(|| rho_s() * specular_albedo(cos, DEFAULT_M, F0_SKIN) * radiance)
         })
         .collect();
     let (n, _) = compare("constant environment", |i| img[i * 4], &expected);
@@ -590,7 +591,7 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
     let img = render(&s, View::named("irradiance"));
     let want = std::f32::consts::PI
         * radiance
-        * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M))
+        * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M, F0_SKIN))
         * ALBEDO.powf(s.file.skin.mix);
     let expected: Vec<Option<f32>> = img
         .chunks_exact(4)
@@ -623,7 +624,7 @@ fn furnace(albedo: Texture, rho: f32) {
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            let reflected = rho_s() * specular_albedo(cos, DEFAULT_M);
+            let reflected = rho_s() * specular_albedo(cos, DEFAULT_M, F0_SKIN);
             (cos >= 0.3).then_some(radiance * (rho * (1.0 - reflected) + reflected))
         })
         .collect();
@@ -665,7 +666,7 @@ fn prefilter_errors(dir: &std::path::Path, name: &str, lights: LightsMode) -> Ve
         let m = prefilter::level_m(k);
         for y in (4..prefilter::HEIGHT).step_by(8) {
             for x in (3..w).step_by(16) {
-                let want = prefilter::reference(&env, prefilter::texel_direction(x, y), m);
+                let want = prefilter::reference(&env, prefilter::texel_direction(x, y), m, F0_SKIN);
                 let i = ((k * prefilter::HEIGHT + y) * w + x) as usize * 4;
                 let got = Vec3::new(img[i], img[i + 1], img[i + 2]);
                 errors.push(((got - want).abs() / want.max(Vec3::splat(1e-3))).max_element());
