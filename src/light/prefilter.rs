@@ -31,17 +31,20 @@ pub const DM: f32 = 0.1;
 pub const FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 pub struct PrefilterPass {
+    /// Built for one F0 (env_prefilter.comp's `LOBE_F0`).
     pipeline: Arc<Pipeline>,
     sampler: Arc<Sampler>,
     image: Arc<Image>,
 }
 
 impl PrefilterPass {
-    /// `sampler`: trilinear where the device filters the environment's format.
-    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
+    /// `sampler`: trilinear where the device filters the environment's format;
+    /// `f0`: the lobe's Schlick F0 (skin::SkinSettings::f0), a specialization
+    /// constant: the environment is prefiltered once per render.
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>, f0: f32) -> Result<Self> {
         let ctx = pipelines.ctx();
         Ok(Self {
-            pipeline: pipelines.compute("env_prefilter.comp", &[])?,
+            pipeline: pipelines.compute("env_prefilter.comp", &[f0.to_bits()])?,
             sampler,
             image: Arc::new(Image::new(
                 ctx,

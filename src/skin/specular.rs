@@ -20,8 +20,9 @@ use glam::Vec3;
 use std::f64::consts::PI;
 
 /// Normal-incidence Fresnel reflectance of skin: ((n−1)/(n+1))² with n ≈ 1.4
-/// gives 0.0278; GPU Gems 3 §14.3 uses 0.028. The lobe's functions take F0 as an
-/// argument; this is d'Eon's.
+/// gives 0.0278; GPU Gems 3 §14.3 uses 0.028. The paper's lobe (`deon2007`, and
+/// a medium's `specular = "regions"`) keeps this constant; a medium's boundary
+/// takes [`f0_from_ior`] of its `ior` (skin::SkinSettings::f0).
 pub const F0_SKIN: f32 = 0.028;
 
 /// Normal-incidence Fresnel reflectance of a dielectric of index `ior` in air,

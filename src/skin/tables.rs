@@ -43,7 +43,7 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
 /// (specular::hemispherical_albedo: what the environment's SH irradiance, whose
 /// incidence angles are lost, gives the specular) beside it in every texel of a
 /// row: interleaved (A, Ā), so the final pass reads both in one fetch. Both at
-/// Schlick's `f0`, the lobe's.
+/// Schlick's `f0`, the lobe's (skin::SkinSettings::f0).
 pub fn albedo_table(n: usize, f0: f32) -> Vec<f32> {
     let a = specular::specular_albedo_lut(n, n, 256, 64, f0);
     let mean: Vec<f32> = (0..n)
