@@ -12,6 +12,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D env;
 layout(binding = 1, rgba16f) writeonly uniform image2D prefiltered;
+// The lobe's Schlick F0 (skin::SkinSettings::f0; light/prefilter.rs sets it):
+// fixed for a render, as the image this pass fills once.
+layout(constant_id = 0) const float LOBE_F0 = 0.028;
 const uint SAMPLES = 1024u;
 
 // Van der Corput radical inverse in base 2 (Hammersley's second coordinate).
@@ -49,7 +52,7 @@ void main() {
         float sin_theta = sqrt(max(1.0 - l.y * l.y, 1e-6));
         float lod = clamp(0.5 * log2(sample_sr / (texel_sr * sin_theta)) + 0.5, 0.0, max_lod);
         // f_KS·(n·l)/pdf = F(h·v)(n·l)/(n·h)² (see skin/specular.rs::specular_albedo).
-        float w = fresnel_schlick(cos_h, F0_SKIN) * n_dot_l / (cos_h * cos_h);
+        float w = fresnel_schlick(cos_h, LOBE_F0) * n_dot_l / (cos_h * cos_h);
         acc += w * textureLod(env, equirect_uv(l), lod).rgb;
         total += w;
     }

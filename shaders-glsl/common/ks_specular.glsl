@@ -8,6 +8,8 @@
 //   SPEC_INTENSITY sampler2D  the specular map s; ρs·(1 + SPEC_MAP_GAIN·min(s/(2s̄), 1))
 //                             with 1/(2s̄) in frame.params.y (skin/specular.rs::map_rho_s)
 //   SPEC_ROUGHNESS sampler2D  m (grey), used when ROUGHNESS_MAP (frame.glsl)
+// Schlick's F0 is frame.params.x (skin::SkinSettings::f0: 0.028 for the paper's
+// lobe, the medium's boundary's from its ior); the albedo table is integrated at it.
 #include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
 layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
@@ -42,7 +44,7 @@ float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
     vec3 h = l + v;
     vec3 hn = normalize(h);
     float d = texture(beckmann_lut, table_uv(beckmann_lut, vec2(dot(n, hn), params.y))).r;
-    float f = fresnel_schlick(dot(hn, v), F0_SKIN);
+    float f = fresnel_schlick(dot(hn, v), frame.params.x);
     return n_dot_l * params.x * max(d * f / dot(h, h), 0.0);
 }
 

@@ -64,7 +64,8 @@ pub struct FrameUniforms {
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],
-    /// x: 0 (free); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
+    /// x: the specular lobe's Schlick F0 (skin::SkinSettings::f0: 0.028, or
+    /// the medium boundary's from its ior); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
     /// (skin::specular::map_rho_s); z, w: the shadow atlas's tile columns and rows.
     pub params: [f32; 4],
 }

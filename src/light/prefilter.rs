@@ -31,17 +31,20 @@ pub const DM: f32 = 0.1;
 pub const FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 pub struct PrefilterPass {
+    /// Built for one F0 (env_prefilter.comp's `LOBE_F0`).
     pipeline: Arc<Pipeline>,
     sampler: Arc<Sampler>,
     image: Arc<Image>,
 }
 
 impl PrefilterPass {
-    /// `sampler`: trilinear where the device filters the environment's format.
-    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>) -> Result<Self> {
+    /// `sampler`: trilinear where the device filters the environment's format;
+    /// `f0`: the lobe's Schlick F0 (skin::SkinSettings::f0), a specialization
+    /// constant: the environment is prefiltered once per render.
+    pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>, f0: f32) -> Result<Self> {
         let ctx = pipelines.ctx();
         Ok(Self {
-            pipeline: pipelines.compute("env_prefilter.comp", &[])?,
+            pipeline: pipelines.compute("env_prefilter.comp", &[f0.to_bits()])?,
             sampler,
             image: Arc::new(Image::new(
                 ctx,
@@ -91,15 +94,15 @@ pub fn level_m(k: u32) -> f32 {
 }
 
 /// CPU reference of one prefiltered value: Σ L(l)·w(l)·dω / Σ w(l)·dω over every
-/// texel of `env`, with w = the KS lobe ks_brdf(r, l, r, m, 1) (N·L included) —
-/// brute force, no sampling.
-pub fn reference(env: &EnvMap, r: Vec3, m: f32) -> Vec3 {
+/// texel of `env`, with w = the KS lobe ks_brdf(r, l, r, m, 1, f0) (N·L
+/// included) — brute force, no sampling.
+pub fn reference(env: &EnvMap, r: Vec3, m: f32, f0: f32) -> Vec3 {
     let (mut acc, mut total) = (Vec3::ZERO, 0.0f64);
     for y in 0..env.height {
         let d_omega = crate::scene::env::texel_solid_angle(y, env.width, env.height);
         for x in 0..env.width {
             let l = env.texel_direction(x, y);
-            let w = ks_brdf(r, l, r, m, 1.0) * d_omega;
+            let w = ks_brdf(r, l, r, m, 1.0, f0) * d_omega;
             if w > 0.0 {
                 acc += env.texel(x, y) * w;
                 total += f64::from(w);
@@ -112,11 +115,12 @@ pub fn reference(env: &EnvMap, r: Vec3, m: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skin::specular::F0_SKIN;
 
     #[test]
     fn a_constant_environment_prefilters_to_itself() {
         let env = EnvMap::uniform(Vec3::new(0.2, 0.5, 1.5), 256, 128);
-        let v = reference(&env, Vec3::new(0.3, 0.4, -0.2).normalize(), 0.3);
+        let v = reference(&env, Vec3::new(0.3, 0.4, -0.2).normalize(), 0.3, F0_SKIN);
         assert!(
             (v - Vec3::new(0.2, 0.5, 1.5)).abs().max_element() < 1e-4,
             "{v}"
@@ -134,9 +138,9 @@ mod tests {
                 0.0
             })
         });
-        let smooth = reference(&env, Vec3::Z, 0.1).x;
-        let rough = reference(&env, Vec3::Z, 0.5).x;
-        let away = reference(&env, -Vec3::Z, 0.3).x;
+        let smooth = reference(&env, Vec3::Z, 0.1, F0_SKIN).x;
+        let rough = reference(&env, Vec3::Z, 0.5, F0_SKIN).x;
+        let away = reference(&env, -Vec3::Z, 0.3, F0_SKIN).x;
         assert!(smooth > 0.5 && smooth < 1.0, "{smooth}");
         assert!(rough < 0.5 * smooth, "{rough} vs {smooth}");
         assert!(away < 1e-3, "{away}");

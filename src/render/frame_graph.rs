@@ -60,12 +60,14 @@ fn depth_range(scene: &Scene) -> DepthRange {
 
 /// The frame's uniforms: camera at `aspect`, the environment's rotation and
 /// intensity, the lights and their shadow projections; `specular_scale`: 0.5
-/// over the specular map's mean.
+/// over the specular map's mean; `f0`: the specular lobe's Schlick F0
+/// (skin::SkinSettings::f0).
 fn frame_uniforms(
     scene: &Scene,
     lighting: &Lighting,
     aspect: f32,
     specular_scale: f32,
+    f0: f32,
 ) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let tiles = lighting.tiles().len();
@@ -86,7 +88,7 @@ fn frame_uniforms(
             if lighting.occlusion { 1.0 } else { 0.0 },
         ],
         params: [
-            0.0,
+            f0,
             specular_scale,
             atlas_grid(tiles).0 as f32,
             atlas_grid(tiles).1 as f32,
@@ -314,7 +316,7 @@ impl Passes {
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res, false)?,
             hard_visibility: VisibilityPass::new(p, variant, res, true)?,
-            prefilter: PrefilterPass::new(p, inputs.env_sampler.clone())?,
+            prefilter: PrefilterPass::new(p, inputs.env_sampler.clone(), skin.f0)?,
             debug: DebugPass::new(p, &scene.regions)?,
             meter: Meter::new(p, s.nearest.clone())?,
             glow: Glow::new(p, s.nearest.clone(), s.linear.clone())?,
@@ -415,12 +417,19 @@ impl Frame {
                 (specular_map.0, specular_map.1, &scene.specular.rgba8),
             )
         };
-        let uniforms = frame_uniforms(scene, &lighting, w as f32 / h as f32, specular_scale);
+        let uniforms = frame_uniforms(
+            scene,
+            &lighting,
+            w as f32 / h as f32,
+            specular_scale,
+            skin.f0,
+        );
         let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms, &skin)?;
         let s = &inputs.samplers;
         let tables = SpecularTables::new(
             ctx,
             &skin.regions,
+            skin.f0,
             &scene.regions,
             s.linear.clone(),
             s.nearest.clone(),
@@ -473,7 +482,13 @@ impl Frame {
         }
         let (w, h) = (scene.file.render.width, scene.file.render.height);
         let aspect = w as f32 / h as f32;
-        let uniforms = frame_uniforms(scene, &self.lighting, aspect, self.specular_scale);
+        let uniforms = frame_uniforms(
+            scene,
+            &self.lighting,
+            aspect,
+            self.specular_scale,
+            self.skin.f0,
+        );
         self.inputs.uniforms = upload_buffer(
             ctx,
             "frame uniforms",

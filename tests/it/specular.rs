@@ -20,7 +20,8 @@ use dermis::scene::mesh::Mesh;
 use dermis::scene::texture::{Encoding, Texture};
 use dermis::scene::{Light, LightSource, Scene};
 use dermis::skin::specular::{
-    hemispherical_albedo, ks_brdf, map_rho_s, specular_albedo, DEFAULT_M, DEFAULT_RHO_S,
+    boundary_rho_s, f0_from_ior, fresnel_schlick, hemispherical_albedo, ks_brdf, map_rho_s,
+    specular_albedo, DEFAULT_M, DEFAULT_RHO_S, F0_SKIN,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -219,13 +220,110 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
                 // Stay away from the silhouette.
                 (n.dot(v) >= 0.3).then(|| {
                     let (l, e) = light.at(p);
-                    ks_brdf(n, l, v, DEFAULT_M, rho_s()) * e.x
+                    ks_brdf(n, l, v, DEFAULT_M, rho_s(), F0_SKIN) * e.x
                 })
             })
             .collect();
         let (n, _) = compare(&format!("{:?}", light.source), |i| img[i * 4], &expected);
         assert!(n > 10_000);
     }
+}
+
+/// With a medium the specular is its boundary, a dielectric of its `ior`:
+/// Schlick's F0 = ((n − 1)/(n + 1))² (0.0201 at 1.33, 0.0465 at 1.55), in the
+/// lobe (the frame uniform) as in ρs (skin::specular::boundary_rho_s). A sphere
+/// of Jensen's skin1 at each ior under one directional light 110° from the
+/// view, the specular view: each against the CPU lobe at its F0 pixel by pixel
+/// (1 % + 1/255 of the peak), and the 1.55 sphere's specular over the 1.33
+/// one's, summed over the pixels compared, against the CPU's ratio. That ratio
+/// is the Fresnel ratio F(H·V, 0.0465)/F(H·V, 0.0201) at the pixels' angles
+/// (× ρs's, 1.00): 2.32 at H·V = 1, 1.56–1.68 at this light's H·V ≈ 0.57. The
+/// tolerance is a tenth of what F0 adds to the ratio at these angles over a
+/// constant F0's, so a constant F0 misses by ten tolerances, and so does the
+/// bare F0 ratio (the angles matter).
+#[test]
+fn a_mediums_ior_sets_the_boundarys_fresnel() {
+    use dermis::scene::file::MediumPreset;
+    let light = Light {
+        // From the side and a little behind: 110° from the camera (on +Z).
+        source: LightSource::Directional(Vec3::new(0.94, 0.15, -0.342).normalize()),
+        irradiance: Vec3::splat(200.0),
+        shadow: false,
+        angular_radius: 0.0,
+    };
+    let (low, high) = (1.33f32, 1.55f32);
+    let (f0_low, f0_high) = (f0_from_ior(low), f0_from_ior(high));
+    // Per ior: (GPU, CPU) specular at each pixel compared, None elsewhere.
+    let run = |ior: f32| {
+        let mut s = scene(
+            sphere(Vec3::ZERO, R, 192, 96, (0.0, 1.0)),
+            vec![light],
+            EnvMap::uniform(Vec3::ZERO, 64, 32),
+        );
+        s.file.skin.medium.preset = Some(MediumPreset::JensenSkin1);
+        s.file.skin.medium.ior = ior;
+        let f0 = f0_from_ior(ior);
+        let rho_s = boundary_rho_s(DEFAULT_M, f0);
+        let img = render(&s, View::named("specular"));
+        let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
+            .into_iter()
+            .map(|h| {
+                let (_, p) = h?;
+                let (n, v) = (p.normalize(), (s.camera.position - p).normalize());
+                (n.dot(v) >= 0.3).then(|| {
+                    let (l, e) = light.at(p);
+                    ks_brdf(n, l, v, DEFAULT_M, rho_s, f0) * e.x
+                })
+            })
+            .collect();
+        let (n, _) = compare(&format!("medium, ior {ior}"), |i| img[i * 4], &expected);
+        assert!(n > 10_000);
+        (img, expected, s.camera)
+    };
+    let (img_low, cpu_low, camera) = run(low);
+    let (img_high, cpu_high, _) = run(high);
+    let rho_ratio = boundary_rho_s(DEFAULT_M, f0_high) / boundary_rho_s(DEFAULT_M, f0_low);
+    // Sums over the pixels where both lobes are above a thousandth of their
+    // peak, and the range of the per-pixel Fresnel ratios there.
+    let peak = cpu_low.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
+    let hits = pixel_hits(&camera, &[(Vec3::ZERO, R)]);
+    let l = match light.source {
+        LightSource::Directional(d) => d,
+        LightSource::Point(_) => unreachable!(),
+    };
+    let (mut gpu, mut cpu) = ([0.0f64; 2], [0.0f64; 2]);
+    // The Fresnel ratio's range over those pixels (printed).
+    let (mut lo, mut hi) = (f32::MAX, 0.0f32);
+    for (i, h) in hits.iter().enumerate() {
+        let (Some(a), Some(b), Some((_, p))) = (cpu_low[i], cpu_high[i], h) else {
+            continue;
+        };
+        if a < 1e-3 * peak {
+            continue;
+        }
+        gpu[0] += f64::from(img_low[i * 4]);
+        gpu[1] += f64::from(img_high[i * 4]);
+        cpu[0] += f64::from(a);
+        cpu[1] += f64::from(b);
+        let v = (camera.position - *p).normalize();
+        let h_dot_v = (l + v).normalize().dot(v);
+        let r = rho_ratio * fresnel_schlick(h_dot_v, f0_high) / fresnel_schlick(h_dot_v, f0_low);
+        (lo, hi) = (lo.min(r), hi.max(r));
+    }
+    let (got, want) = ((gpu[1] / gpu[0]) as f32, (cpu[1] / cpu[0]) as f32);
+    let tolerance = 0.1 * (want - rho_ratio);
+    let bare = rho_ratio * f0_high / f0_low;
+    println!(
+        "specular, ior {high} over ior {low}: GPU {got:.4}, CPU {want:.4} (± {tolerance:.4}); \
+         per-pixel Fresnel ratios {lo:.3}..{hi:.3}; the bare F0 ratio {bare:.3}; \
+         a constant F0: {rho_ratio:.4}"
+    );
+    assert!(want - rho_ratio > 0.5, "the view sees F0: {want}");
+    assert!(
+        (bare - want).abs() > 3.0 * tolerance,
+        "the angles matter: {want}"
+    );
+    assert!((got - want).abs() <= tolerance, "{got} against {want}");
 }
 
 /// Whether the segment from `p` towards the light (`l`, up to `t_max`) misses
@@ -440,11 +538,12 @@ fn soft_shadows_follow_the_source_size() {
     );
 }
 
-/// A(cos θ, m) by the CPU quadrature at 257 angles, interpolated linearly: A
-/// is smooth in cos θ, and the quadrature is too slow to call per texel.
-fn specular_albedo_table() -> impl Fn(f32) -> f32 {
+/// A(cos θ, m) at Schlick F0 `f0` by the CPU quadrature at 257 angles,
+/// interpolated linearly: A is smooth in cos θ, and the quadrature is too slow
+/// to call per texel.
+fn specular_albedo_table(f0: f32) -> impl Fn(f32) -> f32 {
     let table: Vec<f32> = (0..=256)
-        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M))
+        .map(|i| specular_albedo(i as f32 / 256.0, DEFAULT_M, f0))
         .collect();
     move |c: f32| {
         let x = c.clamp(0.0, 1.0) * 256.0;
@@ -459,7 +558,7 @@ fn shadow_maps_shadow_the_texture_space_irradiance() {
     let img = render(&s.scene, View::named("irradiance"));
     let res = s.scene.file.render.irradiance_resolution as usize;
     let mix = s.scene.file.skin.mix;
-    let albedo = specular_albedo_table();
+    let albedo = specular_albedo_table(F0_SKIN);
     // The big sphere covers the left half of the texture.
     let mut points = Vec::new();
     let expected: Vec<Option<f32>> = (0..res * res)
@@ -513,7 +612,7 @@ fn irradiance_at_the_uv_raster(shading: IrradianceShading) {
     s.file.render.irradiance_shading = shading;
     let img = render(&s, View::named("irradiance"));
     let res = s.file.render.irradiance_resolution as usize;
-    let (albedo, mix) = (specular_albedo_table(), s.file.skin.mix);
+    let (albedo, mix) = (specular_albedo_table(F0_SKIN), s.file.skin.mix);
     let m = &s.mesh;
     let mut expected = vec![None; res * res];
     for t in m.indices.chunks_exact(3) {
@@ -569,7 +668,7 @@ fn environment_specular_is_exact_under_a_constant_environment() {
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            (cos >= 0.3).then(|| rho_s() * specular_albedo(cos, DEFAULT_M) * radiance)
+            (cos >= 0.3).then(|| rho_s() * specular_albedo(cos, DEFAULT_M, F0_SKIN) * radiance)
         })
         .collect();
     let (n, _) = compare("constant environment", |i| img[i * 4], &expected);
@@ -590,7 +689,7 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
     let img = render(&s, View::named("irradiance"));
     let want = std::f32::consts::PI
         * radiance
-        * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M))
+        * (1.0 - rho_s() * hemispherical_albedo(DEFAULT_M, F0_SKIN))
         * ALBEDO.powf(s.file.skin.mix);
     let expected: Vec<Option<f32>> = img
         .chunks_exact(4)
@@ -602,6 +701,91 @@ fn environment_enters_the_skin_less_what_the_specular_reflects() {
         "entry factor 1 − ρs·Ā = {:.4}",
         want / (std::f32::consts::PI * radiance * ALBEDO.powf(s.file.skin.mix))
     );
+}
+
+/// A medium's boundary under a uniform sky L: it reflects ρs·A(N·V, m)·L toward
+/// the viewer and lets in 1 − ρs·Ā(m) of the irradiance πL, both at its ior's
+/// Schlick F0 (skin::SkinSettings::f0; the albedo table is integrated at it).
+/// At ior 1.55 (F0 0.0465, ρs from skin::specular::boundary_rho_s at it), the
+/// specular view pixel by pixel and the irradiance texture texel by texel
+/// (within 1 % plus 1/255 of the peak, as above) against the CPU quadrature at
+/// that F0; d'Eon's 0.028 would reflect 40 % less at normal incidence. What
+/// enters differs by only 2 % between ior 1.33 and 1.55, under what the 1 %
+/// per texel can tell, so also the mean entry factor at 1.55 over that at 1.33
+/// (what the whole chain shares, the SH's quadrature of πL, cancels; 0.2 % in
+/// each) against the CPU's ratio, within a tenth of what F0 changes in it: a
+/// constant F0 misses by ten tolerances (measured: 0.9748 against 0.9744
+/// ± 0.0025; a constant F0 0.9999).
+#[test]
+fn a_mediums_boundary_reflects_and_admits_by_its_f0() {
+    use dermis::scene::file::MediumPreset;
+    let (radiance, m) = (10.0, DEFAULT_M);
+    let with_ior = |ior: f32| {
+        let mut s = scene(
+            sphere(Vec3::ZERO, R, 192, 96, (0.0, 1.0)),
+            Vec::new(),
+            EnvMap::uniform(Vec3::splat(radiance), 64, 32),
+        );
+        s.file.skin.medium.preset = Some(MediumPreset::JensenSkin1);
+        s.file.skin.medium.ior = ior;
+        s
+    };
+    let s = with_ior(1.55);
+    let f0 = f0_from_ior(1.55);
+    let (rho_s, albedo) = (boundary_rho_s(m, f0), specular_albedo_table(f0));
+    let (rho_0, albedo_0) = (boundary_rho_s(m, F0_SKIN), specular_albedo_table(F0_SKIN));
+    let img = render(&s, View::named("specular"));
+    let expected: Vec<Option<f32>> = pixel_hits(&s.camera, &[(Vec3::ZERO, R)])
+        .into_iter()
+        .map(|h| {
+            let (_, p) = h?;
+            let cos = p.normalize().dot((s.camera.position - p).normalize());
+            (cos >= 0.3).then(|| rho_s * albedo(cos) * radiance)
+        })
+        .collect();
+    let (n, _) = compare("ior 1.55, uniform sky, specular", |i| img[i * 4], &expected);
+    assert!(n > 10_000);
+    let at_normal = (rho_0 * albedo_0(1.0)) / (rho_s * albedo(1.0));
+    println!("reflected at normal incidence with F0 0.028: {at_normal:.3} of the ior's");
+    assert!(at_normal < 0.7, "{at_normal}");
+
+    // What enters: (GPU mean over the covered texels, 1 − ρs·Ā at the ior's
+    // F0, the same at 0.028), each over πL·albedo^mix.
+    let scale = std::f32::consts::PI * radiance * ALBEDO.powf(s.file.skin.mix);
+    let entry = |ior: f32| {
+        let img = render(&with_ior(ior), View::named("irradiance"));
+        let rho_s = boundary_rho_s(m, f0_from_ior(ior));
+        let want = 1.0 - rho_s * hemispherical_albedo(m, f0_from_ior(ior));
+        let constant = 1.0 - rho_s * hemispherical_albedo(m, F0_SKIN);
+        let expected: Vec<Option<f32>> = img
+            .chunks_exact(4)
+            .map(|t| (t[3] > 0.999).then_some(scale * want))
+            .collect();
+        let (n, _) = compare(
+            &format!("ior {ior}, uniform sky, entry"),
+            |i| img[i * 4],
+            &expected,
+        );
+        assert!(n > 10_000, "{n}");
+        let covered: Vec<f64> = img
+            .chunks_exact(4)
+            .filter(|t| t[3] > 0.999)
+            .map(|t| f64::from(t[0] / scale))
+            .collect();
+        let mean = (covered.iter().sum::<f64>() / covered.len() as f64) as f32;
+        println!(
+            "ior {ior}: entry factor GPU mean {mean:.5}, CPU {want:.5}, at F0 0.028 {constant:.5}"
+        );
+        (mean, want, constant)
+    };
+    let (low, high) = (entry(1.33), entry(1.55));
+    let (got, want, constant) = (high.0 / low.0, high.1 / low.1, high.2 / low.2);
+    let tolerance = 0.1 * (want - constant).abs();
+    println!(
+        "entry at ior 1.55 over 1.33: GPU {got:.5}, CPU {want:.5} (± {tolerance:.5}), \
+         a constant F0 {constant:.5}"
+    );
+    assert!((got - want).abs() <= tolerance, "{got} against {want}");
 }
 
 /// The furnace through the whole frame: a sphere of albedo `rho` (`albedo`, its
@@ -623,7 +807,7 @@ fn furnace(albedo: Texture, rho: f32) {
         .map(|h| {
             let (_, p) = h?;
             let cos = p.normalize().dot((s.camera.position - p).normalize());
-            let reflected = rho_s() * specular_albedo(cos, DEFAULT_M);
+            let reflected = rho_s() * specular_albedo(cos, DEFAULT_M, F0_SKIN);
             (cos >= 0.3).then_some(radiance * (rho * (1.0 - reflected) + reflected))
         })
         .collect();
@@ -665,7 +849,7 @@ fn prefilter_errors(dir: &std::path::Path, name: &str, lights: LightsMode) -> Ve
         let m = prefilter::level_m(k);
         for y in (4..prefilter::HEIGHT).step_by(8) {
             for x in (3..w).step_by(16) {
-                let want = prefilter::reference(&env, prefilter::texel_direction(x, y), m);
+                let want = prefilter::reference(&env, prefilter::texel_direction(x, y), m, F0_SKIN);
                 let i = ((k * prefilter::HEIGHT + y) * w + x) as usize * 4;
                 let got = Vec3::new(img[i], img[i + 1], img[i + 2]);
                 errors.push(((got - want).abs() / want.max(Vec3::splat(1e-3))).max_element());
