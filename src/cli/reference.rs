@@ -160,7 +160,11 @@ fn diffusion(
         scene.environment.source = env;
         let opts = d::DiffusionOptions {
             scene,
-            chains: vec![Chain::Full, Chain::Adaptive],
+            chains: vec![
+                (Chain::Full, false),
+                (Chain::Adaptive, false),
+                (Chain::Adaptive, true),
+            ],
             stride,
             out_dir: out_dir.as_ref().map(|dir| dir.join(k.to_string())),
         };

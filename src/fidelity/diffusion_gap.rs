@@ -44,7 +44,8 @@ const MIN_COVERAGE: f32 = 1e-3;
 #[derive(Clone, Debug)]
 pub struct DiffusionOptions {
     pub scene: SceneFile,
-    pub chains: Vec<Chain>,
+    /// The chains compared, each with or without the fold term (skin::fold).
+    pub chains: Vec<(Chain, bool)>,
     /// Every `stride`-th texel in u and v is compared.
     pub stride: u32,
     /// Where to write the reference's and each chain's diffused irradiance and
@@ -57,6 +58,8 @@ pub struct DiffusionOptions {
 pub struct DiffusionRow {
     pub environment: String,
     pub chain: String,
+    /// With the fold term (skin.fold_correction).
+    pub fold_correction: bool,
     pub resolution: u32,
     pub stride: u32,
     /// Per region: name, error, and the bias per channel (R, G, B).
@@ -171,8 +174,9 @@ pub fn run(
     let weights: Vec<Vec3> = skin.profile.gaussians.iter().map(|g| g.weights).collect();
     let mut reference = None;
     let mut rows = Vec::new();
-    for &chain in &opts.chains {
+    for &(chain, fold) in &opts.chains {
         scene.file.skin.chain = chain;
+        scene.file.skin.fold_correction = fold;
         let names: Vec<String> = std::iter::once("irradiance".to_string())
             .chain((1..=6).map(|k| format!("blur{k}")))
             .chain(std::iter::once("translucent_front".to_string()))
@@ -215,7 +219,7 @@ pub fn run(
             .iter()
             .map(|p| chain_at(p.uv, levels[0].at(p.uv).unwrap_or(Vec3::ZERO)))
             .collect();
-        let name = format!("{chain:?}").to_lowercase();
+        let name = format!("{chain:?}{}", if fold { "+fold" } else { "" }).to_lowercase();
         let mut regions = reference
             .masks
             .iter()
@@ -249,6 +253,7 @@ pub fn run(
         let row = DiffusionRow {
             environment: scene.file.environment.source.to_string(),
             chain: name,
+            fold_correction: fold,
             resolution: skin.resolution,
             stride: opts.stride,
             regions,

@@ -28,7 +28,9 @@
 //! reference's: no term there. A texel is listed where Σ|w_y| ≥ [`MIN_ERROR`].
 
 use super::chain::Level;
-use super::reference::{gaussian, texels, Grid, MeshEdges, AIR_ELEVATION_DEG, EXTENT_SIGMA};
+use super::reference::{
+    gaussian, texels_of_every_triangle, Grid, MeshEdges, AIR_ELEVATION_DEG, EXTENT_SIGMA,
+};
 use crate::atomic::write_atomic;
 use crate::cache::{fnv1a64, hex};
 use crate::error::Result;
@@ -50,6 +52,9 @@ pub const MIN_ERROR: f32 = 0.01;
 /// tissue what the chain does not. A curved surface's chord against its
 /// geodesic, or the stretch varying across the kernel, stays under it.
 const GROSS_SIGMA: f32 = 2.0;
+/// A Gaussian narrower than this many texels is integrated over a source
+/// texel, not sampled at its centre ([`mass`]).
+const BOX_SIGMA: f32 = 2.0;
 /// A texel covered less than this is a chart border's (more than one
 /// sub-sample of [`coverage`] missing).
 const PARTIAL: f32 = 0.98;
@@ -153,7 +158,7 @@ impl FoldTerm {
 }
 
 /// Changed with the term's rules, so that no cached term of older rules is read.
-const VERSION: &str = "fold term 1";
+const VERSION: &str = "fold term 2";
 /// The first bytes of a cached term.
 const MAGIC: &[u8; 8] = b"DRMFOLD1";
 
@@ -360,23 +365,26 @@ struct Point {
     area: f32,
 }
 
-/// The covered texels of an N × N image, and a grid to find them in 3-D.
+/// The covered texels of an N × N image (a texel of overlapping charts once
+/// per surface point), and a grid to find them in 3-D.
 struct Surface {
     side: u32,
-    /// Per texel, its index in `points`, or `u32::MAX`.
+    /// Per texel, the index in `points` of its first point, or `u32::MAX`.
     index: Vec<u32>,
     points: Vec<Point>,
 }
 
 impl Surface {
     fn new(mesh: &Mesh, jacobians: &[(Vec3, Vec3)], side: u32) -> Surface {
-        let texels = texels(
+        // Every surface point a texel's centre maps to: where UV charts
+        // overlap, each of their surfaces reads the texel (and the reference
+        // integrates over both).
+        let texels = texels_of_every_triangle(
             &mesh.positions,
             &mesh.normals,
             &mesh.uvs,
             &mesh.indices,
             side,
-            1,
         );
         let covered = coverage(mesh, side);
         let mut index = vec![u32::MAX; (side as usize).pow(2)];
@@ -385,7 +393,10 @@ impl Surface {
             .iter()
             .enumerate()
             .map(|(i, t)| {
-                index[(t.y * side + t.x) as usize] = i as u32;
+                let first = &mut index[(t.y * side + t.x) as usize];
+                if *first == u32::MAX {
+                    *first = i as u32;
+                }
                 let (du, dv) = jacobians[t.triangle as usize];
                 let (share, offset) = covered[(t.y * side + t.x) as usize];
                 Point {
@@ -451,6 +462,22 @@ fn evaluate(
         let duv = uv - x.uv;
         (x.du * duv.x + x.dv * duv.y).length_squared()
     };
+    // The chain's kernel over the texel at `uv`: as [`mass`], in x's metric.
+    let narrow = v < BOX_SIGMA * BOX_SIGMA * area_x;
+    let uv_mass = |uv: Vec2| {
+        if !narrow {
+            return gaussian(v, uv_distance2(uv)) * area_x;
+        }
+        let step = 1.0 / SUBSAMPLES as f32;
+        let mut sum = 0.0;
+        for j in 0..SUBSAMPLES {
+            for i in 0..SUBSAMPLES {
+                let a = (Vec2::new(i as f32, j as f32) + 0.5) * step - 0.5;
+                sum += gaussian(v, uv_distance2(uv + a / n));
+            }
+        }
+        sum * step * step * area_x
+    };
     // The ellipse |J Δuv| ≤ reach bounds Δu by reach·√(G⁻¹)_uu.
     let half = |g: f32| ((reach * (g / det).sqrt() * n).ceil() as i32).min(MAX_WINDOW);
     let (hu, hv) = (half(c), half(a));
@@ -459,11 +486,11 @@ fn evaluate(
     let mut plane = 0.0f32;
     for j in centre.y - hv..=centre.y + hv {
         for i in centre.x - hu..=centre.x + hu {
-            let d2 = uv_distance2((Vec2::new(i as f32, j as f32) + 0.5) / n);
-            if d2 > reach2 {
+            let uv = (Vec2::new(i as f32, j as f32) + 0.5) / n;
+            if uv_distance2(uv) > reach2 {
                 continue;
             }
-            plane += gaussian(v, d2) * area_x;
+            plane += uv_mass(uv);
             ids.extend(sources.at(i, j));
         }
     }
@@ -483,23 +510,23 @@ fn evaluate(
     ids.dedup();
     let rise = x.normal / AIR_ELEVATION_DEG.to_radians().sin();
     let margin = GROSS_SIGMA * v.sqrt();
-    // (source, K, T, whether the term takes it), and the 3-D kernel's reach.
+    // (source, K, T, whether the term takes it, through the air), K as a share of the chain's
+    // discrete kernel, T as the 3-D kernel's mass over the texel's surface;
+    // and that mass over everything within reach.
     let mut weighed = Vec::with_capacity(ids.len());
     let mut reach3 = 0.0f32;
     for s in ids {
         let y = &sources.points[s as usize];
         let d2_uv = uv_distance2(y.uv);
-        let k = if d2_uv <= reach2 {
-            gaussian(v, d2_uv) * area_x
-        } else {
-            0.0
+        let k = match d2_uv <= reach2 {
+            true => uv_mass(y.uv) / plane,
+            false => 0.0,
         };
         let offset = y.centroid - x.position;
         let d2 = offset.length_squared();
-        let g = if d2 <= reach2 {
-            gaussian(v, d2) * y.area
-        } else {
-            0.0
+        let g = match d2 <= reach2 {
+            true => mass(x.position, y, n, v),
+            false => 0.0,
         };
         reach3 += g;
         let air = offset.dot(rise) > d2.sqrt();
@@ -510,16 +537,27 @@ fn evaluate(
         let apart = (d2_uv.sqrt() - d2.sqrt()).abs() > margin;
         // A chart border's texel counts whole in the chain, in part in the tissue.
         let takes = !far_side && (apart || (air && k > 0.0) || y.share < PARTIAL);
-        weighed.push((y.texel, k, t, takes));
+        weighed.push((y.texel, k, t, takes, air));
     }
     // Near an open boundary the reference divides by the 3-D kernel's reach.
     let norm = match open {
         true if reach3 > 0.0 => reach3,
-        _ => plane,
+        _ => 1.0,
     };
+    // The chain compounds its levels: a kernel that keeps less than the
+    // chain's mass would lose it again at every later level (the increments'
+    // product, not the whole Gaussian's share). Less surface within reach
+    // than a plane holds (a thin rim) is left to the chain's normalisation;
+    // more (a fold's other side) adds, and the air's share is taken away.
+    let kept: f32 = weighed
+        .iter()
+        .map(|&(_, k, t, takes, air)| if takes && !air { t } else { k })
+        .sum::<f32>()
+        / norm;
+    let norm = norm * kept.min(1.0);
     let scale = weighed.iter().map(|p| p.1).sum::<f32>() / norm;
     let (mut error, mut out) = (0.0f32, Vec::new());
-    for (texel, k, t, takes) in weighed {
+    for (texel, k, t, takes, _) in weighed {
         let w = (t - k) / norm;
         if !takes || w == 0.0 {
             continue;
@@ -530,6 +568,28 @@ fn evaluate(
         }
     }
     (error + (scale - 1.0).abs() >= MIN_ERROR).then_some((scale, out))
+}
+
+/// The mass of G(v, ·) about `x` over the surface texel `y` holds (of an
+/// `n`² image): G at its centre times its area where the Gaussian spans
+/// [`BOX_SIGMA`] texels or more, else the mean of G over a
+/// [`SUBSAMPLES`]² grid across the texel's parallelogram (a point sample of a
+/// Gaussian narrower than a texel over- or undercounts it many times over).
+fn mass(x: Vec3, y: &Point, n: f32, v: f32) -> f32 {
+    if v >= (BOX_SIGMA * BOX_SIGMA) * y.area {
+        return gaussian(v, x.distance_squared(y.centroid)) * y.area;
+    }
+    let side = y.share.sqrt() / n;
+    let (du, dv) = (y.du * side, y.dv * side);
+    let step = 1.0 / SUBSAMPLES as f32;
+    let mut sum = 0.0;
+    for j in 0..SUBSAMPLES {
+        for i in 0..SUBSAMPLES {
+            let (a, b) = ((i as f32 + 0.5) * step - 0.5, (j as f32 + 0.5) * step - 0.5);
+            sum += gaussian(v, x.distance_squared(y.centroid + du * a + dv * b));
+        }
+    }
+    sum * step * step * y.area
 }
 
 /// The term of one level: `v` mm² from `sources` to `targets`, only near the
@@ -732,9 +792,13 @@ mod tests {
     /// largest error of the chain's model, without and with the term, against
     /// the reference without air paths, with E = 1 on the charts left of u = ½.
     fn errors(m: &Mesh) -> (f32, f32) {
+        errors_at(m, SIGMA)
+    }
+
+    fn errors_at(m: &Mesh, sigma: f32) -> (f32, f32) {
         let levels = [Level {
             resolution: SIDE,
-            sigma_mm: Some(SIGMA),
+            sigma_mm: Some(sigma),
             one_pass: None,
         }];
         let term = FoldTerm::compute(m, &levels, SIDE);
@@ -742,7 +806,7 @@ mod tests {
         let jac = jacobians(m);
         let surface = Surface::new(m, &jac, SIDE);
         let e = |uv: Vec2| if uv.x < 0.5 { 1.0 } else { 0.0 };
-        let v = SIGMA * SIGMA;
+        let v = sigma * sigma;
         let reference = Diffusion::new(&m.positions, &m.uvs, &m.indices, &[v]).unwrap();
         let edges = MeshEdges::new(&m.positions, &m.uvs, &m.indices, reference.extent());
         let (mut before, mut after) = (0.0f32, 0.0f32);
@@ -835,6 +899,16 @@ mod tests {
         let (before, after) = errors(&m);
         assert!(before > 0.3, "the chain alone: {before}");
         assert!(after < 0.02, "with the term: {after} (before {before})");
+    }
+
+    #[test]
+    fn a_level_narrower_than_a_texel_is_integrated_over_the_texels() {
+        // σ = 0.12 mm, a third of a texel: point samples would weigh the other
+        // side's nearest texel several times over.
+        let m = mesh(&[quad(-20.0, 0.0, 0.02, 0.45), quad(0.0, 20.0, 0.55, 0.98)]);
+        let (before, after) = errors_at(&m, 0.12);
+        assert!(before > 0.3, "the chain alone: {before}");
+        assert!(after < 0.05, "with the term: {after} (before {before})");
     }
 
     #[test]

@@ -117,13 +117,17 @@ fn texture_space_diffusion_against_the_exact_reference() {
     (scene.render.width, scene.render.height) = (48, 60);
     let opts = DiffusionOptions {
         scene,
-        chains: vec![Chain::Full, Chain::Adaptive],
+        chains: vec![
+            (Chain::Full, false),
+            (Chain::Adaptive, false),
+            (Chain::Adaptive, true),
+        ],
         stride: 4,
         out_dir: None,
     };
     let rows = common::with_gpu(|ctx| run(ctx, &opts, |_| {}).unwrap());
     println!("{}", table(&rows));
-    assert_eq!(rows.len(), 2);
+    assert_eq!(rows.len(), 3);
     for r in &rows {
         let region = |name: &str| {
             r.regions
@@ -179,7 +183,7 @@ fn the_exact_reference_leaves_out_the_chains_transmitted_light() {
         ));
         let opts = DiffusionOptions {
             scene,
-            chains: vec![Chain::Full],
+            chains: vec![(Chain::Full, false)],
             stride: 8,
             out_dir: Some(dir.clone()),
         };

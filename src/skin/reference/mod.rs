@@ -24,7 +24,7 @@ mod texels;
 
 pub use edges::MeshEdges;
 pub use grid::Grid;
-pub use texels::{texels, Texel};
+pub use texels::{texels, texels_of_every_triangle, Texel};
 
 use crate::error::{Error, Result};
 use glam::{Vec2, Vec3};

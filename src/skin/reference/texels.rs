@@ -29,6 +29,30 @@ pub fn texels(
     resolution: u32,
     stride: u32,
 ) -> Vec<Texel> {
+    rasterise(positions, normals, uvs, indices, resolution, stride, true)
+}
+
+/// As [`texels`], but a texel whose centre several triangles' UVs cover (UV
+/// charts that overlap) is listed once for each: every surface point that reads it.
+pub fn texels_of_every_triangle(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    uvs: &[Vec2],
+    indices: &[u32],
+    resolution: u32,
+) -> Vec<Texel> {
+    rasterise(positions, normals, uvs, indices, resolution, 1, false)
+}
+
+fn rasterise(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    uvs: &[Vec2],
+    indices: &[u32],
+    resolution: u32,
+    stride: u32,
+    once: bool,
+) -> Vec<Texel> {
     let n = resolution as usize;
     let stride = stride.max(1) as usize;
     let mut taken = vec![false; n * n];
@@ -50,7 +74,7 @@ pub fn texels(
                 let b1 = (c - q[0]).perp_dot(q[2] - q[0]) / area;
                 let b2 = (q[1] - q[0]).perp_dot(c - q[0]) / area;
                 let b0 = 1.0 - b1 - b2;
-                if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 || taken[y * n + x] {
+                if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 || (once && taken[y * n + x]) {
                     continue;
                 }
                 taken[y * n + x] = true;
