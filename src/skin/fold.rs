@@ -58,8 +58,9 @@ const BOX_SIGMA: f32 = 2.0;
 /// A texel covered less than this is a chart border's (more than one
 /// sub-sample of [`coverage`] missing).
 const PARTIAL: f32 = 0.98;
-/// Sources below this share of the kernel are dropped.
-const MIN_WEIGHT: f32 = 1e-4;
+/// Sources below this share of the kernel are not listed: their weight goes
+/// to the chain's own value (C), as if their light were the texel's.
+const MIN_WEIGHT: f32 = 1e-3;
 /// The UV window holds at most this many source texels either side of x.
 const MAX_WINDOW: i32 = 48;
 /// Levels of at least [`SCREEN_FROM`]² are screened at 1/SCREEN of their side
@@ -158,7 +159,7 @@ impl FoldTerm {
 }
 
 /// Changed with the term's rules, so that no cached term of older rules is read.
-const VERSION: &str = "fold term 2";
+const VERSION: &str = "fold term 3";
 /// The first bytes of a cached term.
 const MAGIC: &[u8; 8] = b"DRMFOLD1";
 
@@ -555,7 +556,7 @@ fn evaluate(
         .sum::<f32>()
         / norm;
     let norm = norm * kept.min(1.0);
-    let scale = weighed.iter().map(|p| p.1).sum::<f32>() / norm;
+    let mut scale = weighed.iter().map(|p| p.1).sum::<f32>() / norm;
     let (mut error, mut out) = (0.0f32, Vec::new());
     for (texel, k, t, takes, _) in weighed {
         let w = (t - k) / norm;
@@ -563,8 +564,10 @@ fn evaluate(
             continue;
         }
         error += w.abs();
-        if w.abs() >= MIN_WEIGHT {
-            out.push((texel, w));
+        // A small source's light is taken as the chain's own there.
+        match w.abs() >= MIN_WEIGHT {
+            true => out.push((texel, w)),
+            false => scale += w,
         }
     }
     (error + (scale - 1.0).abs() >= MIN_ERROR).then_some((scale, out))
@@ -898,7 +901,9 @@ mod tests {
         let m = mesh(&[quad(-20.0, 0.0, 0.02, 0.45), quad(0.0, 20.0, 0.55, 0.98)]);
         let (before, after) = errors(&m);
         assert!(before > 0.3, "the chain alone: {before}");
-        assert!(after < 0.02, "with the term: {after} (before {before})");
+        // The sources under MIN_WEIGHT count as the texel's own light: at a
+        // step from 1 to 0 across the seam that is 2.1 % (under 2 % with them).
+        assert!(after < 0.025, "with the term: {after} (before {before})");
     }
 
     #[test]
