@@ -45,7 +45,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// A texel is corrected where Σ|w_y| reaches this share of its kernel.
-pub const MIN_ERROR: f32 = 0.01;
+pub const MIN_ERROR: f32 = 0.02;
 /// A source is the term's where its distance along the chain's UVs and
 /// through the tissue differ by more than this many σ of the level (their
 /// weights by e² or more): the chain reaches what the tissue does not, or the
@@ -159,7 +159,7 @@ impl FoldTerm {
 }
 
 /// Changed with the term's rules, so that no cached term of older rules is read.
-const VERSION: &str = "fold term 3";
+const VERSION: &str = "fold term 4";
 /// The first bytes of a cached term.
 const MAGIC: &[u8; 8] = b"DRMFOLD1";
 

@@ -161,6 +161,30 @@ fn texture_space_diffusion_against_the_exact_reference() {
             region("UV seams")
         );
     }
+    // The fold term (skin::fold) takes the adaptive chain toward the exact
+    // diffusion without air paths where scattering changes the light, and
+    // leaves the face no worse (docs/records/2026-11-29-fold-term.md).
+    let inside = |r: &dermis::fidelity::diffusion_gap::DiffusionRow, name: &str| {
+        r.regions
+            .iter()
+            .find(|g| g.region.starts_with(name))
+            .map(|g| g.error_inside.mean)
+            .unwrap()
+    };
+    let (chain, fold) = (&rows[1], &rows[2]);
+    assert!(fold.fold_correction && !chain.fold_correction);
+    assert!(
+        inside(fold, "scattering") < 0.8 * inside(chain, "scattering"),
+        "scattering > 20 %: {} with the term, {} without",
+        inside(fold, "scattering"),
+        inside(chain, "scattering")
+    );
+    assert!(
+        inside(fold, "face") <= inside(chain, "face") * 1.05,
+        "face: {} with the term, {} without",
+        inside(fold, "face"),
+        inside(chain, "face")
+    );
 }
 
 /// The reference convolves the light that enters the skin: the sky's light
