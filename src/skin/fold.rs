@@ -55,6 +55,9 @@ const GROSS_SIGMA: f32 = 2.0;
 /// A Gaussian narrower than this many texels is integrated over a source
 /// texel, not sampled at its centre ([`mass`]).
 const BOX_SIGMA: f32 = 2.0;
+/// A kernel that keeps less than this share of the chain's mass (most of its
+/// surface across the air) is renormalised only to it, not to the whole.
+const MIN_KEPT: f32 = 0.5;
 /// A texel covered less than this is a chart border's (more than one
 /// sub-sample of [`coverage`] missing).
 const PARTIAL: f32 = 0.98;
@@ -159,7 +162,7 @@ impl FoldTerm {
 }
 
 /// Changed with the term's rules, so that no cached term of older rules is read.
-const VERSION: &str = "fold term 4";
+const VERSION: &str = "fold term 5";
 /// The first bytes of a cached term.
 const MAGIC: &[u8; 8] = b"DRMFOLD1";
 
@@ -555,7 +558,7 @@ fn evaluate(
         .map(|&(_, k, t, takes, air)| if takes && !air { t } else { k })
         .sum::<f32>()
         / norm;
-    let norm = norm * kept.min(1.0);
+    let norm = norm * kept.clamp(MIN_KEPT, 1.0);
     let mut scale = weighed.iter().map(|p| p.1).sum::<f32>() / norm;
     let (mut error, mut out) = (0.0f32, Vec::new());
     for (texel, k, t, takes, _) in weighed {
@@ -570,7 +573,8 @@ fn evaluate(
             false => scale += w,
         }
     }
-    (error + (scale - 1.0).abs() >= MIN_ERROR).then_some((scale, out))
+    let finite = scale.is_finite() && out.iter().all(|s| s.1.is_finite());
+    (finite && error + (scale - 1.0).abs() >= MIN_ERROR).then_some((scale, out))
 }
 
 /// The mass of G(v, ·) about `x` over the surface texel `y` holds (of an
