@@ -6,26 +6,34 @@
 //!
 //! Every level the chain blurs adds variance v to the previous level's image
 //! (GPU Gems 3 §14.4.2). At a texel x of the level, over the texels y of that
-//! previous image, the chain's kernel is K_y = G(v, |J_x Δuv|²)·A_x: the
-//! Gaussian in UV space under x's surface metric J_x (what the stretch and
-//! shear maps give the blur), on covered texels, A_x the area of a texel under
-//! that metric. The 3-D kernel (skin::reference) is T_y = G(v, |x − y|²)·A_y,
-//! A_y the surface texel y holds; 0 where the chord leaves x through the air
-//! (more than [`AIR_ELEVATION_DEG`] above its tangent plane, as the reference
-//! without air paths counts it); and left to the chain (T_y = K_y) on a thin
-//! part's far side (y faces away from x, and x lies behind y's surface), which
-//! the transmission terms carry (light::transmission, skin::translucent). Both are divided by K's
-//! sum over the whole UV plane at x, the discrete kernel's own normalisation.
+//! previous image, two kernels are compared. The chain's, K_y: the Gaussian
+//! G(v, |J_x Δuv|²) in UV space under x's surface metric J_x (what the
+//! stretch and shear maps give the blur) over texel y, on covered texels, as a
+//! share of its sum over the whole UV plane. The tissue's, T_y: the mass of
+//! G(v, |x − y|²) over the surface texel y holds (skin::reference's kernel;
+//! a chart border's texel holds part of its square). Both are integrated over
+//! the texel where the Gaussian spans under [`BOX_SIGMA`] texels, else sampled
+//! at its centre.
 //!
 //! The chain gives D = Σ K_y E_y / C with C = Σ K_y (it normalises by
 //! coverage), so Σ T_y E_y = C·D + Σ w_y E_y with w_y = T_y − K_y. The pass
 //! replaces D by that: the chain's own share is kept, scaled back by the
 //! coverage it normalised away — which removes the double count (at a seam the
-//! one-sided mean no longer stands in for the other side, which the term now
+//! one-sided mean no longer stands in for the other side, which the term
 //! brings itself) — and the weights move the rest from the UV neighbours to
-//! the 3-D ones. Each corrected level is the next one's source, as in the
-//! chain. Within reach of an open boundary the chain's normalisation is the
-//! reference's: no term there. A texel is listed where Σ|w_y| ≥ [`MIN_ERROR`].
+//! the 3-D ones. Only where the two disagree is a source the term's: its
+//! distances along the UVs and through the tissue differ by more than
+//! [`GROSS_SIGMA`] σ, or the chord leaves x through the air (more than
+//! [`AIR_ELEVATION_DEG`] above its tangent plane: T_y = 0, as the reference
+//! without air paths counts it), or it is a chart border's partial texel;
+//! elsewhere the chain's weight stands. A thin part's far side (y faces away
+//! from x, and x lies behind y's surface) is left to the transmission terms
+//! (light::transmission, skin::translucent). Near an open boundary both are
+//! divided by the tissue kernel's reach, as the reference divides there. Each
+//! corrected level is the next one's source, so a kernel that keeps less than
+//! the chain's mass (a thin rim's missing surface) is renormalised, by at
+//! most 1/[`MIN_KEPT`]; the air's share is still taken away and a fold's
+//! extra surface adds. A texel is listed where |C − 1| + Σ|w_y| ≥ [`MIN_ERROR`].
 
 use super::chain::Level;
 use super::reference::{
@@ -56,7 +64,7 @@ const GROSS_SIGMA: f32 = 2.0;
 /// texel, not sampled at its centre ([`mass`]).
 const BOX_SIGMA: f32 = 2.0;
 /// A kernel that keeps less than this share of the chain's mass (most of its
-/// surface across the air) is renormalised only to it, not to the whole.
+/// surface across the air) is renormalised by this share, not by its own.
 const MIN_KEPT: f32 = 0.5;
 /// A texel covered less than this is a chart border's (more than one
 /// sub-sample of [`coverage`] missing).
