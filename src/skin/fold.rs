@@ -747,17 +747,15 @@ impl FoldPass {
         let Some((_, count, targets, sources)) = self.levels.iter().find(|l| l.0 == k) else {
             return;
         };
-        g.simple_pass(
-            &format!("{}_fold", super::blur::BlurChain::level_name(k + 1)),
-            &self.pipeline,
-        )
-        .tag(super::TAG)
-        .sample(src, &self.sampler)
-        .load_store(level)
-        .buffer(targets)
-        .buffer(sources)
-        .constants(count)
-        .dispatch([*count, 1, 1]);
+        // blurK_fold, after blurK (skin::blur::BlurChain::level_name).
+        g.simple_pass(&format!("blur{}_fold", k + 1), &self.pipeline)
+            .tag(super::TAG)
+            .sample(src, &self.sampler)
+            .load_store(level)
+            .buffer(targets)
+            .buffer(sources)
+            .constants(count)
+            .dispatch([*count, 1, 1]);
     }
 }
 
