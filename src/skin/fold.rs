@@ -138,7 +138,12 @@ impl FoldTerm {
         for (k, level) in levels.iter().enumerate() {
             let side = level.resolution;
             if let Some(sigma) = level.sigma_mm.filter(|s| *s > 0.0) {
-                for n in [source_side, side] {
+                let screens = side >= SCREEN_FROM;
+                let coarse = side / SCREEN;
+                for n in [source_side, side]
+                    .into_iter()
+                    .chain(screens.then_some(coarse))
+                {
                     if !surfaces.iter().any(|s| s.side == n) {
                         surfaces.push(Surface::new(mesh, &jacobians, n));
                     }
@@ -146,8 +151,7 @@ impl FoldTerm {
                 let of = |n: u32| surfaces.iter().find(|s| s.side == n).expect("made above");
                 let (sources, targets) = (of(source_side), of(side));
                 let v = sigma * sigma;
-                let screened = (side >= SCREEN_FROM)
-                    .then(|| screen(mesh, &jacobians, &edges, side / SCREEN, v));
+                let screened = screens.then(|| screen(of(coarse), &edges, v));
                 out.levels.push(level_term(
                     k,
                     (targets, sources),
@@ -480,15 +484,7 @@ fn evaluate(
         if !narrow {
             return gaussian(v, uv_distance2(uv)) * area_x;
         }
-        let step = 1.0 / SUBSAMPLES as f32;
-        let mut sum = 0.0;
-        for j in 0..SUBSAMPLES {
-            for i in 0..SUBSAMPLES {
-                let a = (Vec2::new(i as f32, j as f32) + 0.5) * step - 0.5;
-                sum += gaussian(v, uv_distance2(uv + a / n));
-            }
-        }
-        sum * step * step * area_x
+        texel_mean(|a| gaussian(v, uv_distance2(uv + a / n))) * area_x
     };
     // The ellipse |J Δuv| ≤ reach bounds Δu by reach·√(G⁻¹)_uu.
     let half = |g: f32| ((reach * (g / det).sqrt() * n).ceil() as i32).min(MAX_WINDOW);
@@ -596,15 +592,19 @@ fn mass(x: Vec3, y: &Point, n: f32, v: f32) -> f32 {
     }
     let side = y.share.sqrt() / n;
     let (du, dv) = (y.du * side, y.dv * side);
+    texel_mean(|a| gaussian(v, x.distance_squared(y.centroid + du * a.x + dv * a.y))) * y.area
+}
+
+/// The mean of `f` over a [`SUBSAMPLES`]² grid of offsets in [−½, ½]².
+fn texel_mean(f: impl Fn(Vec2) -> f32) -> f32 {
     let step = 1.0 / SUBSAMPLES as f32;
     let mut sum = 0.0;
     for j in 0..SUBSAMPLES {
         for i in 0..SUBSAMPLES {
-            let (a, b) = ((i as f32 + 0.5) * step - 0.5, (j as f32 + 0.5) * step - 0.5);
-            sum += gaussian(v, x.distance_squared(y.centroid + du * a + dv * b));
+            sum += f((Vec2::new(i as f32, j as f32) + 0.5) * step - 0.5);
         }
     }
-    sum * step * step * y.area
+    sum * step * step
 }
 
 /// The term of one level: `v` mm² from `sources` to `targets`, only near the
@@ -664,12 +664,12 @@ impl Screen {
     }
 }
 
-/// Screens a level of variance `v` at `side`² (sources at the same side): the
-/// Gaussian widened by a coarse texel's area so that it spans the coarse
-/// texels, out to its own reach plus a texel, flags every place a fold lies
-/// within the level's reach.
-fn screen(mesh: &Mesh, jacobians: &[(Vec3, Vec3)], edges: &MeshEdges, side: u32, v: f32) -> Screen {
-    let coarse = Surface::new(mesh, jacobians, side);
+/// Screens a level of variance `v` on the `coarse` surface (sources at the
+/// same side): the Gaussian widened by a coarse texel's area so that it spans
+/// the coarse texels, out to its own reach plus a texel, flags every place a
+/// fold lies within the level's reach.
+fn screen(coarse: &Surface, edges: &MeshEdges, v: f32) -> Screen {
+    let side = coarse.side;
     let texel_area =
         coarse.points.iter().map(|p| p.area).sum::<f32>() / coarse.points.len().max(1) as f32;
     let v = v + texel_area;
@@ -680,7 +680,7 @@ fn screen(mesh: &Mesh, jacobians: &[(Vec3, Vec3)], edges: &MeshEdges, side: u32,
         .par_iter()
         .filter(|x| {
             let open = edges.to_open(x.position).is_some_and(|d| d <= reach);
-            evaluate(x, &coarse, &grid, (v, reach), open).is_some()
+            evaluate(x, coarse, &grid, (v, reach), open).is_some()
         })
         .map(|x| x.texel)
         .collect();
