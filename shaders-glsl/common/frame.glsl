@@ -17,7 +17,7 @@ layout(std140, binding = 0) uniform Frame {
 // marked [[unroll]] (GL_EXT_control_flow_attributes): without it lavapipe (Mesa
 // 22.3) left a body that large rolled (nir_opt_loop_unroll's cost limit, it
 // seems), and the lit close-up's skin pass took 1.7× as long
-// (docs/design/cost-model.md).
+// (docs/records/2026-11-26-light-loops-unrolled.md).
 layout(constant_id = 0) const int LIGHT_COUNT = 0;
 layout(constant_id = 1) const bool OCCLUSION = true;
 layout(constant_id = 2) const bool ROUGHNESS_MAP = false;

@@ -35,7 +35,7 @@ pub fn markdown(command: &mut Command) -> String {
     let mut page = String::from(
         "# Command-line reference\n\n\
          Written by `dermis cli-reference > docs/reference/cli.md` from the command \
-         line's own definition; `cargo test --test docs` fails when it is stale. \
+         line's own definition; `cargo test --test it -- docs::` fails when it is stale. \
          `dermis <command> --help` prints the same.\n",
     );
     section(command, "dermis", &mut page);

@@ -7,7 +7,7 @@ pub const MAX_LIGHTS: usize = 8;
 /// What stays fixed for a whole render and selects code in the shading passes:
 /// their specialization constants (shaders-glsl/common/frame.glsl). Fixed loop
 /// bounds and dead branches removed at pipeline creation matter on CPU drivers,
-/// which run both sides of every branch (docs/design/cost-model.md).
+/// which run both sides of every branch (docs/records/2026-11-24-frame-speed.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ShaderVariant {
     /// Explicit lights, ≤ MAX_LIGHTS.

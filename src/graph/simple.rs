@@ -141,7 +141,7 @@ impl<'g> SimplePass<'g> {
 
     /// The next binding: a graph buffer read as a uniform buffer (it needs
     /// UNIFORM_BUFFER usage). Uniform loads are much cheaper than storage loads on
-    /// CPU drivers (lavapipe: docs/design/cost-model.md).
+    /// CPU drivers (lavapipe: docs/records/2026-11-24-frame-speed.md).
     pub fn read_uniform(mut self, buffer: &BufferHandle) -> Self {
         let r = self.pass.read_buffer(buffer, Access::UniformRead);
         self.bind(Bound::GraphUniform(r))

@@ -17,7 +17,8 @@ use crate::scene::file::Chain;
 /// Smallest total σ, in texels of its own resolution at the mesh's mean stretch,
 /// a level after the first is stored with: a Gaussian narrower than a texel is
 /// not reconstructed by bilinear lookups (the impulse-response test of
-/// tests/it/skin_diffusion.rs fails from about 0.7; docs/design/cost-model.md).
+/// tests/it/skin_diffusion.rs fails from about 0.7;
+/// docs/records/2026-11-29-adaptive-chain-one-texel.md).
 pub const MIN_SIGMA_TEXELS: f32 = 1.0;
 /// A first increment narrower than this (texels at the irradiance resolution) is
 /// not blurred: the level is the irradiance itself.

@@ -2,7 +2,7 @@
 //! the SH environment and the shadowed explicit lights, times albedo^mix. What
 //! no light changes is drawn once per render over a raster of the mesh by its
 //! UVs and kept (the mesh, its maps and the skin settings are fixed for a
-//! render; docs/design/cost-model.md):
+//! render; docs/records/2026-11-26-per-render-terms.md):
 //! - `surface`: the normal-mapped shading normal, albedo^mix, the specular's
 //!   (ρs, m) and the share of the environment's light it lets in, 1 − ρs·Ā(m);
 //! - `texel_map`, for the compute formulation below: per texel the covering

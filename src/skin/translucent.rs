@@ -6,7 +6,7 @@
 //! lights' visibility is (light::visibility). Both sides of the surface
 //! (translucent.frag); the final pass reads the side it shades with one
 //! bilinear lookup instead of a shadow-map thickness and six exponentials per
-//! light and pixel (docs/design/cost-model.md).
+//! light and pixel (docs/records/2026-11-26-per-render-terms.md).
 
 use super::medium_tables::MediumTables;
 use super::tables::SpecularTables;
