@@ -9,7 +9,8 @@ compares each pair's sides:
    half of the pairs is the noise threshold it suggests;
 2. the false-alarm rate: pairs in which any pass came out regressed or
    improved, over the second half (threshold from the first) and over all pairs
-   at the default threshold;
+   at the default threshold, with every run and with the first N of each side
+   (N from --runs);
 3. the smallest change found: the B side's pass PASS scaled by 1 + d in every
    frame, for N runs per side (the first N of each side), the share of pairs in
    which `dermis compare` calls PASS regressed.
@@ -101,6 +102,15 @@ def main():
     print(f"threshold {100 * calib:.2f} %, held-out pairs: {n}/{total} with a false alarm")
 
     side = lambda d: sorted(glob.glob(os.path.join(d, "*.json")))
+    for runs in [int(x) for x in args.runs.split(",")]:
+        cs = []
+        for a, b in pairs:
+            fa, fb = side_copy(side(a), runs), side_copy(side(b), runs)
+            cs.append(compare(fa, fb))
+            shutil.rmtree(fa)
+            shutil.rmtree(fb)
+        n, total = alarms(cs)
+        print(f"the first {runs} runs a side, default threshold: {n}/{total} pairs with a false alarm")
     print(f"\npower: share of pairs in which {args.pass_} × (1 + d) is called regressed")
     print("runs  " + "  ".join(f"{d:>5}%" for d in args.shifts.split(",")))
     for runs in [int(x) for x in args.runs.split(",")]:
