@@ -52,7 +52,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// A texel is corrected where Σ|w_y| reaches this share of its kernel.
+/// A texel is corrected where |C − 1| + Σ|w_y| reaches this share of its kernel.
 pub const MIN_ERROR: f32 = 0.02;
 /// A source is the term's where its distance along the chain's UVs and
 /// through the tissue differ by more than this many σ of the level (their
@@ -749,20 +749,19 @@ fn level_term(
 ) -> FoldLevel {
     let reach = EXTENT_SIGMA * v.sqrt();
     let grid = sources.grid(reach);
-    let evaluated = targets
+    let candidates: Vec<&Point> = targets
         .points
         .iter()
         .filter(|x| screened.is_none_or(|s| s.flags(x.texel)))
-        .count();
+        .collect();
     log::debug!(
-        "fold term: blur{} evaluates {evaluated} of {} texels",
+        "fold term: blur{} evaluates {} of {} texels",
         level + 1,
+        candidates.len(),
         targets.points.len()
     );
-    let mut listed: Vec<(u32, f32, Weights)> = targets
-        .points
-        .par_iter()
-        .filter(|x| screened.is_none_or(|s| s.flags(x.texel)))
+    let mut listed: Vec<(u32, f32, Weights)> = candidates
+        .into_par_iter()
         .filter_map(|x| {
             let open = edges.to_open(x.position).is_some_and(|d| d <= reach);
             evaluate(x, sources, &grid, (v, reach), open, MIN_ERROR)
