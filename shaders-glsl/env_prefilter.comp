@@ -12,7 +12,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D env;
 layout(binding = 1, rgba16f) writeonly uniform image2D prefiltered;
-// The lobe's Schlick F0 (skin::SkinSettings::f0; light/prefilter.rs sets it):
+// The lobe's Schlick F0 (skin::specular::Lobe::schlick_f0; light/prefilter.rs sets it):
 // fixed for a render, as the image this pass fills once.
 layout(constant_id = 0) const float LOBE_F0 = 0.028;
 const uint SAMPLES = 1024u;

@@ -20,7 +20,7 @@ layout(location = 0) out vec4 visibility0;
 layout(location = 1) out vec4 visibility1;
 layout(location = 2) out vec4 visibility2;
 
-layout(constant_id = 5) const bool HARD = false;
+layout(constant_id = 6) const bool HARD = false;
 
 void main() {
     shading_dpdx = dFdx(v_position);

@@ -56,15 +56,15 @@ layout(push_constant) uniform Push {
 } pc;
 // The pass is built with the transmitted term (skin::shade::ShadePass::new);
 // without it the shader is the one without the term.
-layout(constant_id = 5) const bool TRANSMISSION = false;
+layout(constant_id = 6) const bool TRANSMISSION = false;
 // With blur_amount < 1 the unblurred irradiance is mixed in; at 1 (the
 // default) the pass is built without its lookup (skin::shade::ShadePass::new).
-layout(constant_id = 6) const bool UNBLURRED = true;
+layout(constant_id = 7) const bool UNBLURRED = true;
 // The leading levels the chain leaves unblurred (skin::chain: the adaptive
 // chain's first, narrower than SKIP_SIGMA_TEXELS) are the irradiance itself:
 // PIXEL_LEVELS of them, evaluated at the pixel as the irradiance pass does at a
 // texel, and not read from their textures (skin::shade::ShadePass::new).
-layout(constant_id = 7) const uint PIXEL_LEVELS = 0;
+layout(constant_id = 8) const uint PIXEL_LEVELS = 0;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;

@@ -35,7 +35,7 @@ layout(binding = 9) uniform sampler2D transmittance_table;
 layout(push_constant) uniform Push { vec4 weights[6]; float table_max_mm; } pc;
 // T(d) from the medium's table instead of the Gaussians
 // (skin::translucent::TranslucentPass::new).
-layout(constant_id = 5) const bool TABLE = false;
+layout(constant_id = 6) const bool TABLE = false;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;

@@ -208,7 +208,7 @@ def main():
                    help="write BACK_SKY in dermis's convention (docs/scenes/back-sky.exr) and exit")
     p.add_argument("--specular-only", action="store_true",
                    help="an interior that absorbs all it is given: the boundary's reflection "
-                   "alone (dermis: --view specular)")
+                   "alone (dermis: docs/scenes/skin1-boundary.toml, whose interior absorbs too)")
     args = p.parse_args()
     if args.write_back_sky:
         write_exr(args.write_back_sky, {"RGB": back_sky()})

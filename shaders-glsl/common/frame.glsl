@@ -10,7 +10,7 @@ layout(std140, binding = 0) uniform Frame {
     mat4 light_focus[8];    // world → atlas (u, v, depth) in the light's focus tile: where the camera looks
     vec4 light_focus_tile[8];   // x: the focus tile's texel, mm (0: none); y: its nearest surface's depth; zw: its lowest atlas corner
     vec4 env;               // x: rotation (radians, about +Y), y: intensity, z: light count, w: occlusion on (z, w: also below)
-    vec4 params;            // x: the specular's Schlick F0 (ks_specular.glsl), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
+    vec4 params;            // x: the specular lobe's Schlick F0, or with DIELECTRIC_LOBE its ior (ks_specular.glsl), y: 1/(2·specular map mean) (ks_specular.glsl), zw: atlas tiles
 } frame;
 // Fixed for a render (frame::ShaderVariant): the driver drops dead branches, which
 // a CPU driver would otherwise run with masked lanes. Loops over the lights are
@@ -23,3 +23,4 @@ layout(constant_id = 1) const bool OCCLUSION = true;
 layout(constant_id = 2) const bool ROUGHNESS_MAP = false;
 layout(constant_id = 3) const int SHADOWED_LIGHTS = 0;   // bit i: light i has a shadow map
 layout(constant_id = 4) const int SOFT_LIGHTS = 0;       // bit i: light i has an angular size
+layout(constant_id = 5) const bool DIELECTRIC_LOBE = false; // the specular is a medium's boundary (ks_specular.glsl)

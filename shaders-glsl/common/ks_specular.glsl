@@ -8,8 +8,9 @@
 //   SPEC_INTENSITY sampler2D  the specular map s; ρs·(1 + SPEC_MAP_GAIN·min(s/(2s̄), 1))
 //                             with 1/(2s̄) in frame.params.y (skin/specular.rs::map_rho_s)
 //   SPEC_ROUGHNESS sampler2D  m (grey), used when ROUGHNESS_MAP (frame.glsl)
-// Schlick's F0 is frame.params.x (skin::SkinSettings::f0: 0.028 for the paper's
-// lobe, the medium's boundary's from its ior); the albedo table is integrated at it.
+// The lobe is skin::SkinSettings::lobe: the paper's KS lobe with Schlick's F0 in
+// frame.params.x, or with DIELECTRIC_LOBE (frame.glsl) a medium's boundary, a
+// rough dielectric of index frame.params.x; the albedo table integrates the lobe.
 #include "fresnel.glsl"
 layout(binding = SPEC_BECKMANN) uniform sampler2D beckmann_lut;
 layout(binding = SPEC_ALBEDO) uniform sampler2D albedo_lut;
@@ -36,14 +37,30 @@ vec2 specular_params(vec2 uv) {
     return params;
 }
 
-// N·L · ρs · PH·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h) stands for
-// the microfacet denominator); PH from the table.
+// Smith's Λ for Beckmann by Walter et al. 2007's rational fit (eq. 27),
+// a = cot θ / m (skin/specular.rs::smith_lambda_rational).
+float smith_lambda(float cos_theta, float m) {
+    float c = clamp(cos_theta, 1e-4, 1.0);
+    float a = c / (m * sqrt(max(1.0 - c * c, 1e-8)));
+    return a >= 1.6 ? 0.0 : (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
+}
+
+// KS: N·L · ρs · PH·F / dot(h, h), h = L + V unnormalised (KS 2001: dot(h,h)
+// stands for the microfacet denominator). A medium's boundary: ρs·PH·F·G₂/(4 N·V),
+// the microfacet BRDF times N·L with ρs = 1/π (skin/specular.rs::Lobe::eval).
+// PH from the table.
 float ks_specular(vec3 n, vec3 l, vec3 v, vec2 params) {
     float n_dot_l = dot(n, l);
     if (n_dot_l <= 0.0) return 0.0;
     vec3 h = l + v;
     vec3 hn = normalize(h);
     float d = texture(beckmann_lut, table_uv(beckmann_lut, vec2(dot(n, hn), params.y))).r;
+    if (DIELECTRIC_LOBE) {
+        float n_dot_v = max(dot(n, v), 1e-4);
+        float f = fresnel_dielectric(max(dot(hn, v), 0.0), frame.params.x);
+        float g = 1.0 / (1.0 + smith_lambda(n_dot_l, params.y) + smith_lambda(n_dot_v, params.y));
+        return params.x * max(d * f * g / (4.0 * n_dot_v), 0.0);
+    }
     float f = fresnel_schlick(dot(hn, v), frame.params.x);
     return n_dot_l * params.x * max(d * f / dot(h, h), 0.0);
 }

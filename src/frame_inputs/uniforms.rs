@@ -16,6 +16,9 @@ pub struct ShaderVariant {
     pub occlusion: bool,
     /// The scene gave a roughness map (else the regions' m is used).
     pub roughness_map: bool,
+    /// The specular lobe is a medium's boundary, a rough dielectric whose ior
+    /// is `params.x` (else the paper's KS lobe, Schlick's F0 there).
+    pub dielectric_lobe: bool,
     /// Bit i: light i has a shadow map.
     pub shadowed: u32,
     /// Bit i: light i has an angular size, so its shadow has a penumbra
@@ -24,14 +27,15 @@ pub struct ShaderVariant {
 }
 
 impl ShaderVariant {
-    /// `constant_id` 0..=4 of frame.glsl.
-    pub fn specialization(&self) -> [u32; 5] {
+    /// `constant_id` 0..=5 of frame.glsl.
+    pub fn specialization(&self) -> [u32; 6] {
         [
             self.lights,
             u32::from(self.occlusion),
             u32::from(self.roughness_map),
             self.shadowed,
             self.soft,
+            u32::from(self.dielectric_lobe),
         ]
     }
 }
@@ -64,8 +68,8 @@ pub struct FrameUniforms {
     /// x: environment rotation (radians about +Y), y: intensity, z: light count,
     /// w: occlusion on.
     pub env: [f32; 4],
-    /// x: the specular lobe's Schlick F0 (skin::SkinSettings::f0: 0.028, or
-    /// the medium boundary's from its ior); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
+    /// x: the specular lobe's parameter (skin::specular::Lobe::parameter:
+    /// Schlick's F0 0.028 for the paper's lobe, a medium boundary's ior); y: 1/(2 s̄), s̄ the specular map's mean over the mesh
     /// (skin::specular::map_rho_s); z, w: the shadow atlas's tile columns and rows.
     pub params: [f32; 4],
 }

@@ -39,7 +39,7 @@ pub struct PrefilterPass {
 
 impl PrefilterPass {
     /// `sampler`: trilinear where the device filters the environment's format;
-    /// `f0`: the lobe's Schlick F0 (skin::SkinSettings::f0), a specialization
+    /// `f0`: the lobe's Schlick F0 (skin::specular::Lobe::schlick_f0), a specialization
     /// constant: the environment is prefiltered once per render.
     pub fn new(pipelines: &Pipelines, sampler: Arc<Sampler>, f0: f32) -> Result<Self> {
         let ctx = pipelines.ctx();

@@ -39,6 +39,7 @@ use crate::skin::fold::{FoldPass, FoldTerm};
 use crate::skin::irradiance::IrradiancePass;
 use crate::skin::shade::{ShadeImages, ShadeMode, ShadePass, ShadeSettings};
 use crate::skin::specular;
+use crate::skin::specular::Lobe;
 use crate::skin::stretch::StretchMaps;
 use crate::skin::tables::SpecularTables;
 use crate::skin::translucent::TranslucentPass;
@@ -60,14 +61,14 @@ fn depth_range(scene: &Scene) -> DepthRange {
 
 /// The frame's uniforms: camera at `aspect`, the environment's rotation and
 /// intensity, the lights and their shadow projections; `specular_scale`: 0.5
-/// over the specular map's mean; `f0`: the specular lobe's Schlick F0
-/// (skin::SkinSettings::f0).
+/// over the specular map's mean; `lobe`: the specular lobe
+/// (skin::SkinSettings::lobe), whose parameter the shaders read.
 fn frame_uniforms(
     scene: &Scene,
     lighting: &Lighting,
     aspect: f32,
     specular_scale: f32,
-    f0: f32,
+    lobe: Lobe,
 ) -> FrameUniforms {
     let vp = scene.camera.view_projection(aspect);
     let tiles = lighting.tiles().len();
@@ -88,7 +89,7 @@ fn frame_uniforms(
             if lighting.occlusion { 1.0 } else { 0.0 },
         ],
         params: [
-            f0,
+            lobe.parameter(),
             specular_scale,
             atlas_grid(tiles).0 as f32,
             atlas_grid(tiles).1 as f32,
@@ -222,6 +223,7 @@ fn frame_inputs(
             lights: lights.len() as u32,
             occlusion: lighting.occlusion,
             roughness_map: scene.file.textures.roughness.is_some(),
+            dielectric_lobe: matches!(skin.lobe, Lobe::Dielectric { .. }),
             shadowed: bits(&|i| views[i].is_some()),
             // Soft shadows where the map can take them: directional (linear depth).
             soft: bits(&|i| {
@@ -316,7 +318,7 @@ impl Passes {
             shadow: ShadowPass::new(p, &lighting.tiles(), lighting.shadow_resolution)?,
             visibility: VisibilityPass::new(p, variant, res, false)?,
             hard_visibility: VisibilityPass::new(p, variant, res, true)?,
-            prefilter: PrefilterPass::new(p, inputs.env_sampler.clone(), skin.f0)?,
+            prefilter: PrefilterPass::new(p, inputs.env_sampler.clone(), skin.lobe.schlick_f0())?,
             debug: DebugPass::new(p, &scene.regions)?,
             meter: Meter::new(p, s.nearest.clone())?,
             glow: Glow::new(p, s.nearest.clone(), s.linear.clone())?,
@@ -422,14 +424,14 @@ impl Frame {
             &lighting,
             w as f32 / h as f32,
             specular_scale,
-            skin.f0,
+            skin.lobe,
         );
         let inputs = frame_inputs(ctx, scene, albedo, &lighting, residual, &uniforms, &skin)?;
         let s = &inputs.samplers;
         let tables = SpecularTables::new(
             ctx,
             &skin.regions,
-            skin.f0,
+            skin.lobe,
             &scene.regions,
             s.linear.clone(),
             s.nearest.clone(),
@@ -487,7 +489,7 @@ impl Frame {
             &self.lighting,
             aspect,
             self.specular_scale,
-            self.skin.f0,
+            self.skin.lobe,
         );
         self.inputs.uniforms = upload_buffer(
             ctx,

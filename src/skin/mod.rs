@@ -57,11 +57,11 @@ pub struct SkinSettings {
     pub blur_amount: f32,
     /// KS parameters of the ten face regions (specular::REGION_NAMES order).
     pub regions: Vec<SpecularRegion>,
-    /// Schlick's F0 of the specular lobe: ((n − 1)/(n + 1))² of the medium's
-    /// `ior` where the lobe is its boundary, else d'Eon's constant 0.028
-    /// (specular::F0_SKIN). The lobe, its albedo table (what the boundary
-    /// takes from the light entering) and the prefiltered environment use it.
-    pub f0: f32,
+    /// The specular lobe: a medium's boundary (a rough dielectric of its
+    /// `ior`), else the paper's KS lobe at d'Eon's F0 0.028. The lobe, its
+    /// albedo table (what the boundary takes from the light entering) and the
+    /// prefiltered environment follow it.
+    pub lobe: specular::Lobe,
     pub kernel: BlurKernel,
     /// Resolutions of the blur levels (skin::chain).
     pub chain: Chain,
@@ -160,20 +160,20 @@ impl SkinSettings {
                 })
                 .collect()
         });
-        let f0 = match &medium {
-            Some(m) if m.boundary_specular() => specular::f0_from_ior(m.medium.ior),
-            _ => specular::F0_SKIN,
+        let lobe = match &medium {
+            Some(m) if m.boundary_specular() => specular::Lobe::Dielectric { ior: m.medium.ior },
+            _ => specular::Lobe::PAPER,
         };
-        if medium.as_ref().is_some_and(MediumSkin::boundary_specular) {
+        if let specular::Lobe::Dielectric { .. } = lobe {
             for r in &mut regions {
-                r.rho_s = specular::boundary_rho_s(r.m, f0);
+                r.rho_s = specular::DIELECTRIC_RHO_S;
             }
         }
         Ok(Self {
             profile,
             blur_amount: skin.blur_amount,
             regions,
-            f0,
+            lobe,
             kernel: match skin.kernel {
                 KernelChoice::Deon7 => BlurKernel::Fixed(Kernel::deon7()),
                 KernelChoice::Accurate => BlurKernel::Accurate,

@@ -103,7 +103,7 @@ pub struct ShadePass {
 
 /// `constant_id` of skin.frag's `TRANSMISSION`, after frame.glsl's; then
 /// `UNBLURRED` and `PIXEL_LEVELS`.
-const TRANSMISSION_CONSTANT: usize = 5;
+const TRANSMISSION_CONSTANT: usize = 6;
 
 impl ShadePass {
     /// `transmission`: build the final pass with the transmitted term (a

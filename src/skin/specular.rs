@@ -1,6 +1,7 @@
 //! Kelemen/Szirmay-Kalos (KS) specular for skin: Beckmann distribution,
 //! Schlick Fresnel, the directional albedo ρ_dt used for energy conservation,
-//! the look-up tables the GPU samples, and the per-region (ρ_s, m) table.
+//! the look-up tables the GPU samples, and the per-region (ρ_s, m) table; and
+//! the lobe of a medium's boundary, a rough dielectric ([`Lobe`]).
 //!
 //! Sources:
 //! - Yang, Wang & Zuo 2012, eq. 1 (Beckmann distribution) and §II.A;
@@ -8,7 +9,10 @@
 //!   `fresnelReflectance`, `KS_Skin_Specular` and `computeRhodtTex` (cited by
 //!   name; listing numbers not verified here);
 //! - Kelemen & Szirmay-Kalos 2001, "A Microfacet Based Coupled Specular-Matte
-//!   BRDF Model with Importance Sampling".
+//!   BRDF Model with Importance Sampling";
+//! - Walter, Marschner, Li & Torrance 2007, "Microfacet Models for Refraction
+//!   through Rough Surfaces" (Smith's Λ for Beckmann, its rational fit, eq. 27);
+//!   Heitz 2014 (the height-correlated G₂).
 //!
 //! Conventions (see `docs/design/skin.md`): vectors are unit length and point away
 //! from the surface; `m` is the Beckmann RMS slope; `rho_s` is the specular
@@ -16,13 +20,14 @@
 //! [`ks_brdf`] uses d'Eon's [`beckmann_ph`], which has no 1/π, because ρ_s = 0.18
 //! and m = 0.3 are d'Eon's values for that lobe (the calibration in `docs/design/skin.md`).
 
+use super::walk::fresnel_dielectric;
 use glam::Vec3;
 use std::f64::consts::PI;
 
 /// Normal-incidence Fresnel reflectance of skin: ((n−1)/(n+1))² with n ≈ 1.4
 /// gives 0.0278; GPU Gems 3 §14.3 uses 0.028. The paper's lobe (`deon2007`, and
 /// a medium's `specular = "regions"`) keeps this constant; a medium's boundary
-/// takes [`f0_from_ior`] of its `ior` (skin::SkinSettings::f0).
+/// is a rough dielectric of its `ior` ([`Lobe::Dielectric`]).
 pub const F0_SKIN: f32 = 0.028;
 
 /// Normal-incidence Fresnel reflectance of a dielectric of index `ior` in air,
@@ -30,6 +35,111 @@ pub const F0_SKIN: f32 = 0.028;
 pub fn f0_from_ior(ior: f32) -> f32 {
     let r = (ior - 1.0) / (ior + 1.0);
     r * r
+}
+
+/// The specular lobe the shaders' `ks_specular` evaluates: frame.params.x
+/// carries [`Lobe::parameter`], frame.glsl's `DIELECTRIC_LOBE` selects the form.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lobe {
+    /// The paper's KS lobe ([`ks_brdf`]), Schlick's Fresnel at `f0`.
+    Ks { f0: f32 },
+    /// A medium's boundary, a rough dielectric of index `ior` in air: the
+    /// microfacet BRDF D·F·G₂/(4 (N·L)(N·V)) with Beckmann D, Smith's
+    /// height-correlated G₂ (Walter et al.'s rational Λ, as the shader has no
+    /// erf) and the exact unpolarised Fresnel. ρs = [`DIELECTRIC_RHO_S`] makes
+    /// the lobe that BRDF (its PH = π·D).
+    Dielectric { ior: f32 },
+}
+
+/// ρs of a [`Lobe::Dielectric`]: 1/π cancels PH's π, leaving the BRDF itself.
+pub const DIELECTRIC_RHO_S: f32 = std::f32::consts::FRAC_1_PI;
+
+impl Lobe {
+    /// The paper's lobe: KS at d'Eon's F0.
+    pub const PAPER: Lobe = Lobe::Ks { f0: F0_SKIN };
+
+    /// What frame.params.x holds: Schlick's F0, or the dielectric's ior.
+    pub fn parameter(self) -> f32 {
+        match self {
+            Lobe::Ks { f0 } => f0,
+            Lobe::Dielectric { ior } => ior,
+        }
+    }
+
+    /// Schlick's F0 of the lobe: where only the lobe's shape is needed (the
+    /// prefiltered environment's normalised weights, the occlusion lobe's
+    /// spread), the dielectric's ((n − 1)/(n + 1))², which its exact Fresnel
+    /// matches within 1 % about normal incidence.
+    pub fn schlick_f0(self) -> f32 {
+        match self {
+            Lobe::Ks { f0 } => f0,
+            Lobe::Dielectric { ior } => f0_from_ior(ior),
+        }
+    }
+
+    /// The lobe's Fresnel reflectance at H·V.
+    pub fn fresnel(self, h_dot_v: f64) -> f64 {
+        match self {
+            Lobe::Ks { f0 } => fresnel_f64(h_dot_v, f64::from(f0)),
+            Lobe::Dielectric { ior } => fresnel_dielectric(h_dot_v, 1.0 / f64::from(ior)),
+        }
+    }
+
+    /// Reflected radiance toward `v` per unit radiance from `l`, times N·L, as
+    /// the shader's `ks_specular` computes it: [`ks_brdf`] for `Ks`; for
+    /// `Dielectric` ρs·PH·F·G₂/(4 N·V). 0 where N·L ≤ 0.
+    pub fn eval(self, n: Vec3, l: Vec3, v: Vec3, m: f32, rho_s: f32) -> f32 {
+        let ior = match self {
+            Lobe::Ks { f0 } => return ks_brdf(n, l, v, m, rho_s, f0),
+            Lobe::Dielectric { ior } => ior,
+        };
+        let (n_dot_l, n_dot_v) = (n.dot(l), n.dot(v).max(1e-4));
+        if n_dot_l <= 0.0 {
+            return 0.0;
+        }
+        let h = (l + v).normalize_or_zero();
+        let f = fresnel_dielectric(f64::from(h.dot(v)), 1.0 / f64::from(ior)) as f32;
+        let g = smith_g2_rational(f64::from(n_dot_l), f64::from(n_dot_v), f64::from(m)) as f32;
+        rho_s * beckmann_ph(n.dot(h), m) * f * g / (4.0 * n_dot_v)
+    }
+
+    /// Directional albedo with ρs = 1, A(cos θ, m): see [`specular_albedo`].
+    pub fn albedo(self, cos_theta: f32, m: f32) -> f32 {
+        albedo_f64(
+            f64::from(cos_theta),
+            f64::from(m),
+            self,
+            ALBEDO_N_XI,
+            ALBEDO_N_PHI,
+        ) as f32
+    }
+
+    /// Its cosine-weighted mean over incidence: see [`hemispherical_albedo`].
+    pub fn hemispherical_albedo(self, m: f32) -> f32 {
+        const N: usize = 128;
+        let sum: f64 = (0..N)
+            .map(|k| {
+                let mu = (k as f64 + 0.5) / N as f64;
+                albedo_f64(mu, f64::from(m), self, ALBEDO_N_XI / 4, ALBEDO_N_PHI / 4) * mu
+            })
+            .sum();
+        (2.0 * sum / N as f64) as f32
+    }
+
+    /// [`Lobe::albedo`] as a `size_cos` × `size_m` table (row-major,
+    /// endpoint-inclusive, see [`table_point`]), integrated on an `n_xi` ×
+    /// `n_phi` grid: the renderer's start-up table (256 × 64 is within 1e-5 of
+    /// the fine grid).
+    pub fn albedo_lut(self, size_cos: usize, size_m: usize, n_xi: usize, n_phi: usize) -> Vec<f32> {
+        let mut lut = Vec::with_capacity(size_cos * size_m);
+        for j in 0..size_m {
+            for i in 0..size_cos {
+                let (c, m) = (table_point(i, size_cos), table_point(j, size_m));
+                lut.push(albedo_f64(f64::from(c), f64::from(m), self, n_xi, n_phi) as f32);
+            }
+        }
+        lut
+    }
 }
 
 /// d'Eon's default roughness where no measured value is used (GPU Gems 3 §14.3).
@@ -188,16 +298,14 @@ const ALBEDO_N_PHI: usize = 256;
 /// in φ) is within 4e-5 of a 4096 × 1024 grid (tested; the worst case is grazing
 /// and rough, where the N·L > 0 cut-off puts a kink in the integrand).
 pub fn specular_albedo(cos_theta: f32, m: f32, f0: f32) -> f32 {
-    albedo_f64(
-        f64::from(cos_theta),
-        f64::from(m),
-        f64::from(f0),
-        ALBEDO_N_XI,
-        ALBEDO_N_PHI,
-    ) as f32
+    Lobe::Ks { f0 }.albedo(cos_theta, m)
 }
 
-fn albedo_f64(cos_theta: f64, m: f64, f0: f64, n_xi: usize, n_phi: usize) -> f64 {
+/// [`Lobe::albedo`] on an `n_xi` × `n_phi` grid. With H sampled by its Beckmann
+/// density, dω_L = 4 (V·H) dω_h: KS's PH·F·(N·L)/(h·h) gives the integrand
+/// F (N·L) / ((V·H)(N·H)), the dielectric's PH·F·G₂/(4 N·V) gives
+/// F G₂ (V·H) / ((N·V)(N·H)); both times π.
+fn albedo_f64(cos_theta: f64, m: f64, lobe: Lobe, n_xi: usize, n_phi: usize) -> f64 {
     let c = cos_theta.clamp(0.0, 1.0);
     let m = m.max(0.0);
     // V = (v_x, 0, v_z) in the xz-plane, N = +z.
@@ -222,7 +330,14 @@ fn albedo_f64(cos_theta: f64, m: f64, f0: f64, n_xi: usize, n_phi: usize) -> f64
             if n_dot_l <= 0.0 {
                 continue;
             }
-            sum += fresnel_f64(v_dot_h, f0) * n_dot_l / (v_dot_h * cos_h);
+            let f = lobe.fresnel(v_dot_h);
+            sum += match lobe {
+                Lobe::Ks { .. } => f * n_dot_l / (v_dot_h * cos_h),
+                Lobe::Dielectric { .. } => {
+                    let n_dot_v = v_z.max(1e-4);
+                    f * smith_g2_rational(n_dot_l, n_dot_v, m) * v_dot_h / (n_dot_v * cos_h)
+                }
+            };
         }
     }
     PI * sum / (n_xi * n_phi) as f64
@@ -234,20 +349,7 @@ fn albedo_f64(cos_theta: f64, m: f64, f0: f64, n_xi: usize, n_phi: usize) -> f64
 /// irradiance pass takes from the environment's SH irradiance (whose incidence
 /// angles it does not know) before the light enters the skin.
 pub fn hemispherical_albedo(m: f32, f0: f32) -> f32 {
-    const N: usize = 128;
-    let sum: f64 = (0..N)
-        .map(|k| {
-            let mu = (k as f64 + 0.5) / N as f64;
-            albedo_f64(
-                mu,
-                f64::from(m),
-                f64::from(f0),
-                ALBEDO_N_XI / 4,
-                ALBEDO_N_PHI / 4,
-            ) * mu
-        })
-        .sum();
-    (2.0 * sum / N as f64) as f32
+    Lobe::Ks { f0 }.hemispherical_albedo(m)
 }
 
 /// erf by Abramowitz & Stegun 7.1.26 (|error| ≤ 1.5e-7).
@@ -267,63 +369,33 @@ fn smith_lambda(cos_theta: f64, m: f64) -> f64 {
     (erf(a) - 1.0) / 2.0 + (-a * a).exp() / (2.0 * a * PI.sqrt())
 }
 
-/// Directional albedo of a dielectric microfacet surface, the physical lobe the
-/// KS model approximates: D F G₂ / (4 (N·L)(N·V)) with the normalised Beckmann D,
-/// Schlick F at `f0` and the height-correlated Smith G₂ = 1/(1 + Λ(L) + Λ(V))
-/// (Heitz 2014), integrated over light directions on a 1024 × 512 midpoint
-/// grid in (cos θ_L, φ_L) — independently of [`specular_albedo`]'s quadrature.
-pub fn microfacet_albedo(cos_theta: f32, m: f32, f0: f32) -> f32 {
-    microfacet_albedo_on(cos_theta, m, f0, (1024, 512))
+/// Smith's Λ for Beckmann by Walter et al. 2007's rational fit (eq. 27; its G₁
+/// within 0.31 % of erf's, tested): a = cot θ / m, Λ = (1 − 1.259a + 0.396a²)/(3.535a + 2.181a²)
+/// below a = 1.6, else 0. What the shader computes (ks_specular.glsl).
+fn smith_lambda_rational(cos_theta: f64, m: f64) -> f64 {
+    let c = cos_theta.clamp(1e-9, 1.0);
+    let a = c / (m * (1.0 - c * c).max(0.0).sqrt()).max(1e-12);
+    if a >= 1.6 {
+        return 0.0;
+    }
+    (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a)
 }
 
-/// [`microfacet_albedo`]'s cosine-weighted mean over incidence, 2∫A(μ)μ dμ
-/// (32-point midpoint rule in μ, each A on a 256 × 128 grid: within 0.3 % of
-/// the fine one, tested).
-pub fn microfacet_hemispherical_albedo(m: f32, f0: f32) -> f32 {
-    const N: usize = 32;
-    let sum: f32 = (0..N)
-        .map(|k| {
-            let mu = (k as f32 + 0.5) / N as f32;
-            microfacet_albedo_on(mu, m, f0, (256, 128)) * mu
-        })
-        .sum();
-    2.0 * sum / N as f32
+/// The height-correlated G₂ = 1/(1 + Λ(L) + Λ(V)) with [`smith_lambda_rational`].
+fn smith_g2_rational(n_dot_l: f64, n_dot_v: f64, m: f64) -> f64 {
+    1.0 / (1.0 + smith_lambda_rational(n_dot_l, m) + smith_lambda_rational(n_dot_v, m))
 }
 
-/// ρs that gives the KS lobe a rough dielectric surface's reflectance. KS is
-/// ρs·PH·F/(h·h) with PH = π·D and h·h = 4(H·V)², so ρs = 1/π is the
-/// Cook–Torrance lobe with Kelemen & Szirmay-Kalos's G/(cos θi cos θo) ≈
-/// 1/(H·V)², which keeps less light than Smith's G, more so when rough. The
-/// scale on 1/π that brings the KS directional albedo closest to Smith's
-/// microfacet one ([`microfacet_albedo`]) in the worst angle of cos θ ∈
-/// [0.3, 1] (minimax): 1.08 at m = 0.2, 1.10 at m = 0.3 (within 4.3 %), both
-/// with Schlick's F at `f0` (the boundary's, [`f0_from_ior`]).
-pub fn boundary_rho_s(m: f32, f0: f32) -> f32 {
-    let ratios: Vec<f32> = (0..8)
-        .map(|k| {
-            let cos = 0.3 + 0.7 * k as f32 / 7.0;
-            microfacet_albedo_on(cos, m, f0, (256, 128)) * PI as f32 / specular_albedo(cos, m, f0)
-        })
-        .collect();
-    let (lo, hi) = ratios
-        .iter()
-        .fold((f32::MAX, 0.0f32), |(lo, hi), &r| (lo.min(r), hi.max(r)));
-    // KS(k/π)/Smith = k/r: the worst angles meet at k/lo − 1 = 1 − k/hi.
-    2.0 * lo * hi / (lo + hi) / PI as f32
-}
-
-fn microfacet_albedo_on(cos_theta: f32, m: f32, f0: f32, grid: (usize, usize)) -> f32 {
-    let f0 = f64::from(f0);
-    microfacet_albedo_with(cos_theta, m, |v_dot_h| fresnel_f64(v_dot_h, f0), grid)
-}
-
-/// [`microfacet_albedo_on`] with the Fresnel reflectance `fresnel(H·V)` given.
-fn microfacet_albedo_with(
-    cos_theta: f32,
-    m: f32,
-    fresnel: impl Fn(f64) -> f64,
-    (n_mu, n_phi): (usize, usize),
-) -> f32 {
+/// Directional albedo of a rough dielectric of index `ior` in air, the lobe
+/// [`Lobe::Dielectric`] stands for, from the exact forms: D F G₂ / (4 (N·L)(N·V))
+/// with the normalised Beckmann D, the exact unpolarised Fresnel and the
+/// height-correlated Smith G₂ = 1/(1 + Λ(L) + Λ(V)) with Λ by erf (Heitz 2014),
+/// integrated over light directions on a 1024 × 512 midpoint grid in
+/// (cos θ_L, φ_L): independent of [`Lobe::albedo`]'s half-vector quadrature
+/// and of its rational Λ.
+pub fn dielectric_albedo(cos_theta: f32, m: f32, ior: f32) -> f32 {
+    let (n_mu, n_phi) = (1024, 512);
+    let eta = 1.0 / f64::from(ior);
     let (c, m) = (f64::from(cos_theta).clamp(1e-4, 1.0), f64::from(m));
     let v = [(1.0 - c * c).sqrt(), 0.0, c];
     let lambda_v = smith_lambda(c, m);
@@ -339,7 +411,8 @@ fn microfacet_albedo_with(
             let h = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
             let len = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
             let (n_dot_h, v_dot_h) = (h[2] / len, (h[0] * v[0] + h[2] * v[2]) / len);
-            let f = beckmann_f64(n_dot_h, m) * fresnel(v_dot_h) * g / (4.0 * mu * c);
+            let f =
+                beckmann_f64(n_dot_h, m) * fresnel_dielectric(v_dot_h, eta) * g / (4.0 * mu * c);
             sum += f * mu;
         }
     }
@@ -353,10 +426,7 @@ pub fn table_point(i: usize, size: usize) -> f32 {
     i as f32 / (size.max(2) - 1) as f32
 }
 
-/// The specular albedo A(cos θ, m) at Fresnel F0 `f0` as a `size_cos` × `size_m`
-/// table (row-major, endpoint-inclusive, see [`table_point`]), integrated on an
-/// `n_xi` × `n_phi` grid: the renderer's start-up table (256 × 64 is within 1e-5
-/// of the fine grid).
+/// [`Lobe::albedo_lut`] of the KS lobe at Schlick's `f0`.
 pub fn specular_albedo_lut(
     size_cos: usize,
     size_m: usize,
@@ -364,14 +434,7 @@ pub fn specular_albedo_lut(
     n_phi: usize,
     f0: f32,
 ) -> Vec<f32> {
-    let mut lut = Vec::with_capacity(size_cos * size_m);
-    for j in 0..size_m {
-        for i in 0..size_cos {
-            let (c, m) = (table_point(i, size_cos), table_point(j, size_m));
-            lut.push(albedo_f64(f64::from(c), f64::from(m), f64::from(f0), n_xi, n_phi) as f32);
-        }
-    }
-    lut
+    Lobe::Ks { f0 }.albedo_lut(size_cos, size_m, n_xi, n_phi)
 }
 
 /// Bilinear look-up in a row-major `width` × `height` table at (x, y) ∈ [0, 1]²,
@@ -567,11 +630,13 @@ mod tests {
     #[test]
     fn albedo_quadrature_is_converged() {
         let mut worst = 0.0_f64;
-        for &c in &[0.02, 0.1, 0.3, 0.6, 1.0] {
-            for &m in &[0.02, 0.1, 0.3, 0.6, 1.0] {
-                let a = albedo_f64(c, m, f64::from(F0_SKIN), ALBEDO_N_XI, ALBEDO_N_PHI);
-                let b = albedo_f64(c, m, f64::from(F0_SKIN), 4 * ALBEDO_N_XI, 4 * ALBEDO_N_PHI);
-                worst = worst.max((a - b).abs());
+        for lobe in [Lobe::PAPER, Lobe::Dielectric { ior: 1.4 }] {
+            for &c in &[0.02, 0.1, 0.3, 0.6, 1.0] {
+                for &m in &[0.02, 0.1, 0.3, 0.6, 1.0] {
+                    let a = albedo_f64(c, m, lobe, ALBEDO_N_XI, ALBEDO_N_PHI);
+                    let b = albedo_f64(c, m, lobe, 4 * ALBEDO_N_XI, 4 * ALBEDO_N_PHI);
+                    worst = worst.max((a - b).abs());
+                }
             }
         }
         println!("albedo: |default − 16× finer grid| ≤ {worst:.2e}");
@@ -725,9 +790,12 @@ mod tests {
 
     #[test]
     fn microfacet_reference_by_hand() {
-        // A smooth dielectric at normal incidence reflects about F0 (G → 1).
-        let a = microfacet_albedo(1.0, 0.15, F0_SKIN);
-        assert!((a - F0_SKIN).abs() < 0.02 * F0_SKIN, "{a}");
+        // A smooth dielectric at normal incidence reflects its F0 (G → 1).
+        let a = dielectric_albedo(1.0, 0.15, 1.4);
+        assert!(
+            (a - f0_from_ior(1.4)).abs() < 0.02 * f0_from_ior(1.4),
+            "{a}"
+        );
         // erf against tabulated values (A&S table 7.1).
         for (x, want) in [(0.5, 0.520_499_9), (1.0, 0.842_700_8), (2.0, 0.995_322_3)] {
             assert!((erf(x) - want).abs() < 3e-7, "erf({x}) = {}", erf(x));
@@ -736,123 +804,89 @@ mod tests {
         assert!(smith_lambda(1.0, 0.3) < 1e-9);
         let l60 = smith_lambda(0.5, 0.3);
         assert!(l60 > 0.0 && l60 < 0.01, "{l60}");
+        // The exact Fresnel by hand at η = 1.4, 60°: sin θt = 0.6186,
+        // rs = (0.5 − 1.4·0.7857)/(0.5 + 1.4·0.7857), rp = (1.4·0.5 − 0.7857)/(…),
+        // F = (0.1406 + 0.0033)/2; Schlick's at the same F0 gives 0.0582.
+        let dielectric = Lobe::Dielectric { ior: 1.4 };
+        let f = dielectric.fresnel(0.5);
+        assert!((f - 0.071_97).abs() < 2e-4, "{f}");
+        assert!((dielectric.fresnel(1.0) - f64::from(f0_from_ior(1.4))).abs() < 1e-7);
     }
 
-    /// A medium's boundary ([`boundary_rho_s`]) against a rough dielectric's
-    /// reflection integrated numerically (Smith's G, the same F): the KS
-    /// lobe's directional albedo within 5 % from normal incidence to
-    /// cos θ = 0.3 at m = 0.2 and 0.3 (skin's), 10 % at m = 0.45; printed per
-    /// angle.
+    /// Walter et al.'s rational Λ against the erf form, as G₁ = 1/(1 + Λ),
+    /// from grazing (a = 0.0125) to where both vanish: within 0.4 % (printed).
     #[test]
-    fn the_boundary_lobe_is_a_dielectric_surface() {
+    fn rational_smith_lambda_fits_the_exact_one() {
+        let m = 1.0;
+        let mut worst = 0.0f64;
+        for k in 1..=400 {
+            let a = 0.0125 * f64::from(k);
+            let cos = a / (1.0 + a * a).sqrt();
+            let exact = 1.0 / (1.0 + smith_lambda(cos, m));
+            let fit = 1.0 / (1.0 + smith_lambda_rational(cos, m));
+            worst = worst.max((fit / exact - 1.0).abs());
+        }
+        println!("rational G₁ within {:.3} % of erf's", 100.0 * worst);
+        assert!(worst < 0.004, "{worst}");
+    }
+
+    /// The dielectric lobe's table quadrature ([`Lobe::albedo`], half-vector
+    /// space, rational Λ) against the rough dielectric integrated over light
+    /// directions with erf's Λ ([`dielectric_albedo`]), with ρs = 1/π: at ior
+    /// 1.33, 1.4, 1.55 and m = 0.2, 0.3, 0.45, from normal incidence to
+    /// cos θ = 0.15, within 1 % (printed). And [`Lobe::eval`] (the shader's
+    /// form) integrated over light directions gives [`Lobe::albedo`].
+    #[test]
+    fn the_dielectric_lobe_is_a_rough_dielectric() {
         let mut worst = 0.0f32;
-        for m in [0.2f32, 0.3, 0.45] {
-            let rho_s = boundary_rho_s(m, F0_SKIN);
-            println!("m = {m}: ρs = {rho_s:.4} = {:.3}/π", rho_s * PI as f32);
-            let tolerance = if m < 0.4 { 0.05 } else { 0.10 };
-            for cos in [1.0f32, 0.8, 0.6, 0.45, 0.3] {
-                let ks = rho_s * specular_albedo(cos, m, F0_SKIN);
-                let reference = microfacet_albedo(cos, m, F0_SKIN);
-                let ratio = ks / reference;
-                println!("m = {m}, cos θ = {cos}: KS {ks:.5}, Smith dielectric {reference:.5}, ratio {ratio:.3}");
-                assert!(
-                    (ratio - 1.0).abs() <= tolerance,
-                    "m {m}, cos {cos}: {ratio}"
-                );
-                worst = worst.max((ratio - 1.0).abs());
+        for ior in [1.33f32, 1.4, 1.55] {
+            let lobe = Lobe::Dielectric { ior };
+            for m in [0.2f32, 0.3, 0.45] {
+                for cos in [1.0f32, 0.8, 0.6, 0.45, 0.3, 0.15] {
+                    let table = DIELECTRIC_RHO_S * lobe.albedo(cos, m);
+                    let reference = dielectric_albedo(cos, m, ior);
+                    let ratio = table / reference;
+                    println!(
+                        "ior {ior}, m {m}, cos θ {cos}: lobe {table:.5}, dielectric {reference:.5} ({ratio:.4})"
+                    );
+                    worst = worst.max((ratio - 1.0).abs());
+                }
             }
         }
-        println!("largest deviation {:.1} %", 100.0 * worst);
-        let coarse = microfacet_hemispherical_albedo(0.3, F0_SKIN);
-        let fine: f32 = (0..64)
-            .map(|k| {
-                let mu = (k as f32 + 0.5) / 64.0;
-                microfacet_albedo(mu, 0.3, F0_SKIN) * mu
-            })
-            .sum::<f32>()
-            * 2.0
-            / 64.0;
-        assert!(
-            (coarse - fine).abs() <= 0.003 * fine,
-            "{coarse} against {fine}"
-        );
+        println!("largest deviation {:.2} %", 100.0 * worst);
+        assert!(worst < 0.01, "{worst}");
+
+        // Lobe::eval over a (θ_L, φ_L) midpoint grid, V at cos θ = 0.6.
+        let (lobe, m, cos) = (Lobe::Dielectric { ior: 1.4 }, 0.3f32, 0.6f32);
+        let v = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+        let (n_t, n_p) = (512, 512);
+        let mut sum = 0.0f64;
+        for i in 0..n_t {
+            let theta = (i as f64 + 0.5) / n_t as f64 * PI / 2.0;
+            for j in 0..n_p {
+                let phi = (j as f64 + 0.5) / n_p as f64 * 2.0 * PI;
+                let l = Vec3::new(
+                    (theta.sin() * phi.cos()) as f32,
+                    (theta.sin() * phi.sin()) as f32,
+                    theta.cos() as f32,
+                );
+                let d_omega = theta.sin() * (PI / 2.0 / n_t as f64) * (2.0 * PI / n_p as f64);
+                sum += f64::from(lobe.eval(Vec3::Z, l, v, m, 1.0)) * d_omega;
+            }
+        }
+        let table = f64::from(lobe.albedo(cos, m));
+        println!("eval integrated {sum:.5}, table {table:.5}");
+        assert!((sum / table - 1.0).abs() < 0.005, "{sum} vs {table}");
     }
 
-    /// With a medium the boundary's Schlick F0 is ((n − 1)/(n + 1))² of its
-    /// ior (skin::SkinSettings::f0). At ior 1.33 and 1.55, the KS lobe's
-    /// directional albedo at that F0 (ρs = [`boundary_rho_s`] at it, m = 0.3)
-    /// against a rough dielectric surface integrated numerically (Smith's G,
-    /// Beckmann D, Schlick's F at the same F0), from normal incidence to
-    /// cos θ = 0.3: each within 5.5 % (4.9 % measured, at 1.33), and the one
-    /// ior's over the other's within 2.5 % of the surfaces' ratio at every
-    /// angle (1.7 % measured; 2.32 at normal incidence, 1.22 at cos θ = 0.3).
-    /// At normal incidence the surface with the ior's exact Fresnel
-    /// (unpolarised) reflects the same within 1 %; off it Schlick's F falls
-    /// under the exact one, by up to 17 % at cos θ = 0.6 (printed, not
-    /// asserted). d'Eon's constant 0.028 would be 40 % under the 1.55 surface.
+    /// The paper's lobe with the scan's face-average parameters (d'Eon's
+    /// region defaults raised by its specular map, map_rho_s, averaged over
+    /// the mesh's surface) reflects less than a rough dielectric of n = 1.4
+    /// with the exact Fresnel: 0.74 of it at normal incidence, 0.61 at
+    /// cos θ = 0.5 (printed). The test holds the calibration to 0.5–1 of it,
+    /// the gap a medium's boundary lobe (Lobe::Dielectric) closes.
     #[test]
-    fn the_boundary_lobe_follows_the_f0_of_its_ior() {
-        let m = DEFAULT_M;
-        let cosines = [1.0f32, 0.8, 0.6, 0.45, 0.3];
-        let ks = |f0: f32| {
-            let rho_s = boundary_rho_s(m, f0);
-            cosines.map(|c| rho_s * specular_albedo(c, m, f0))
-        };
-        let surface = |ior: f32| cosines.map(|c| microfacet_albedo(c, m, f0_from_ior(ior)));
-        let exact = |ior: f32| {
-            let eta = 1.0 / f64::from(ior);
-            cosines.map(|c| {
-                microfacet_albedo_with(
-                    c,
-                    m,
-                    |v_dot_h| crate::skin::walk::fresnel_dielectric(v_dot_h, eta),
-                    (1024, 512),
-                )
-            })
-        };
-        assert!((f0_from_ior(1.33) - 0.020_06).abs() < 1e-5);
-        assert!((f0_from_ior(1.55) - 0.046_52).abs() < 1e-5);
-        assert!((f0_from_ior(1.4) - F0_SKIN).abs() < 3e-4, "d'Eon's n ≈ 1.4");
-        let (low, high) = (1.33f32, 1.55f32);
-        let (ks_low, ks_high) = (ks(f0_from_ior(low)), ks(f0_from_ior(high)));
-        let (surf_low, surf_high) = (surface(low), surface(high));
-        let (exact_low, exact_high) = (exact(low), exact(high));
-        let constant = ks(F0_SKIN);
-        for (k, cos) in cosines.iter().enumerate() {
-            let (a, b) = (ks_low[k] / surf_low[k], ks_high[k] / surf_high[k]);
-            let ratio = (ks_high[k] / ks_low[k]) / (surf_high[k] / surf_low[k]);
-            println!(
-                "cos θ = {cos}: ior {low} KS {:.5} surface {:.5} ({a:.3}, exact Fresnel {:.5}); \
-                 ior {high} KS {:.5} surface {:.5} ({b:.3}, exact Fresnel {:.5}); {high}/{low}: \
-                 KS {:.3}, surface {:.3} ({ratio:.4}); F0 0.028: {:.5} ({:.3} of the {high} surface)",
-                ks_low[k],
-                surf_low[k],
-                exact_low[k],
-                ks_high[k],
-                surf_high[k],
-                exact_high[k],
-                ks_high[k] / ks_low[k],
-                surf_high[k] / surf_low[k],
-                constant[k],
-                constant[k] / surf_high[k],
-            );
-            assert!((a - 1.0).abs() < 0.055, "ior {low}, cos {cos}: {a}");
-            assert!((b - 1.0).abs() < 0.055, "ior {high}, cos {cos}: {b}");
-            assert!((ratio - 1.0).abs() < 0.025, "cos {cos}: {ratio}");
-        }
-        for (surf, exact) in [(surf_low[0], exact_low[0]), (surf_high[0], exact_high[0])] {
-            assert!((surf / exact - 1.0).abs() < 0.01, "{surf} vs {exact}");
-        }
-        // The test sees F0: at normal incidence the 1.55 surface reflects 2.3×
-        // the 1.33 one, and d'Eon's constant misses it.
-        assert!(surf_high[0] / surf_low[0] > 2.0);
-        assert!(constant[0] / surf_high[0] < 0.7, "{}", constant[0]);
-    }
-
-    #[test]
-    fn ks_albedo_at_face_parameters_is_a_dielectric_within_30_percent() {
-        // Face-average parameters of the scan: d'Eon's region defaults raised by
-        // its specular map (map_rho_s), averaged over the mesh's surface.
+    fn ks_albedo_at_face_parameters_is_under_a_dielectrics() {
         let file = crate::scene::file::scene_by_name(None).expect("default scene");
         let mesh = crate::scene::load_mesh(&file).expect("scan");
         let path = file
@@ -872,13 +906,16 @@ mod tests {
         .unwrap();
         for cos in [1.0f32, 0.5] {
             let ks = rho_s * specular_albedo(cos, DEFAULT_M, F0_SKIN);
-            let reference = microfacet_albedo(cos, DEFAULT_M, F0_SKIN);
+            let reference = dielectric_albedo(cos, DEFAULT_M, 1.4);
             println!(
                 "face-average ρs = {rho_s:.4} (s̄ = {s_mean:.3}), m = {DEFAULT_M}, cos θ = {cos}: \
                  KS {ks:.5}, Smith dielectric {reference:.5}, ratio {:.3}",
                 ks / reference
             );
-            assert!((ks / reference - 1.0).abs() <= 0.3, "{ks} vs {reference}");
+            assert!(
+                (0.5..1.0).contains(&(ks / reference)),
+                "{ks} vs {reference}"
+            );
         }
     }
 

@@ -3,7 +3,7 @@
 //! dermis at start-up (skin/specular.rs), and the map of (ρs, m) blended from the
 //! face regions' parameters.
 
-use super::specular;
+use super::specular::{self, Lobe};
 use crate::error::Result;
 use crate::frame_inputs::FrameInputs;
 use crate::gpu::{Context, Image, ImageDesc, Sampler};
@@ -42,12 +42,12 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
 /// n × n) with its cosine-weighted mean over incidence Ā(m)
 /// (specular::hemispherical_albedo: what the environment's SH irradiance, whose
 /// incidence angles are lost, gives the specular) beside it in every texel of a
-/// row: interleaved (A, Ā), so the final pass reads both in one fetch. Both at
-/// Schlick's `f0`, the lobe's (skin::SkinSettings::f0).
-pub fn albedo_table(n: usize, f0: f32) -> Vec<f32> {
-    let a = specular::specular_albedo_lut(n, n, 256, 64, f0);
+/// row: interleaved (A, Ā), so the final pass reads both in one fetch. Both of
+/// the lobe's (skin::SkinSettings::lobe).
+pub fn albedo_table(n: usize, lobe: Lobe) -> Vec<f32> {
+    let a = lobe.albedo_lut(n, n, 256, 64);
     let mean: Vec<f32> = (0..n)
-        .map(|j| specular::hemispherical_albedo(specular::table_point(j, n), f0))
+        .map(|j| lobe.hemispherical_albedo(specular::table_point(j, n)))
         .collect();
     a.iter()
         .enumerate()
@@ -57,7 +57,7 @@ pub fn albedo_table(n: usize, f0: f32) -> Vec<f32> {
 
 pub struct SpecularTables {
     pub beckmann: Arc<Image>,
-    /// [`albedo_table`]: (A(cos θ, m), Ā(m)) at the lobe's F0, RG32F.
+    /// [`albedo_table`]: (A(cos θ, m), Ā(m)) of the lobe, RG32F.
     pub albedo: Arc<Image>,
     /// (ρs, m) per region-map texel, blended across region borders
     /// (specular::region_params_map), RGBA16F.
@@ -67,11 +67,11 @@ pub struct SpecularTables {
 }
 
 impl SpecularTables {
-    /// `f0`: the lobe's Schlick F0 the albedo table is integrated at.
+    /// `lobe`: the specular lobe the albedo table integrates.
     pub fn new(
         ctx: &Arc<Context>,
         regions: &[SpecularRegion],
-        f0: f32,
+        lobe: Lobe,
         region_map: &Texture,
         linear: Arc<Sampler>,
         nearest: Arc<Sampler>,
@@ -106,7 +106,7 @@ impl SpecularTables {
                 "specular albedo table",
                 (ALBEDO_SIZE, ALBEDO_SIZE),
                 vk::Format::R32G32_SFLOAT,
-                albedo_table(ALBEDO_SIZE, f0),
+                albedo_table(ALBEDO_SIZE, lobe),
             )?,
             params: upload_texture(
                 ctx,
@@ -143,14 +143,18 @@ mod tests {
     #[test]
     fn the_albedo_table_holds_a_and_its_mean_per_row() {
         let n = 8;
-        let f0 = specular::F0_SKIN;
-        let t = albedo_table(n, f0);
-        let a = specular::specular_albedo_lut(n, n, 256, 64, f0);
-        assert_eq!(t.len(), 2 * n * n);
-        for (k, pair) in t.chunks_exact(2).enumerate() {
-            assert_eq!(pair[0], a[k]);
-            let m = specular::table_point(k / n, n);
-            assert_eq!(pair[1], specular::hemispherical_albedo(m, f0), "texel {k}");
+        for lobe in [Lobe::PAPER, Lobe::Dielectric { ior: 1.4 }] {
+            let t = albedo_table(n, lobe);
+            let a = lobe.albedo_lut(n, n, 256, 64);
+            assert_eq!(t.len(), 2 * n * n);
+            for (k, pair) in t.chunks_exact(2).enumerate() {
+                assert_eq!(pair[0], a[k]);
+                let m = specular::table_point(k / n, n);
+                assert_eq!(pair[1], lobe.hemispherical_albedo(m), "texel {k}");
+            }
         }
+        // The paper's table is d'Eon's at his F0.
+        let ks = specular::specular_albedo_lut(n, n, 256, 64, specular::F0_SKIN);
+        assert_eq!(albedo_table(n, Lobe::PAPER)[2], ks[1]);
     }
 }

@@ -315,7 +315,7 @@ mod tests {
     }
 
     /// κ(m) was fitted to d'Eon's F0; a medium's boundary takes F0 from its
-    /// ior (skin::SkinSettings::f0). Fresnel barely shapes the lobe at normal
+    /// ior (skin::specular::Lobe::schlick_f0). Fresnel barely shapes the lobe at normal
     /// incidence (H·V is near 1 where the lobe has weight), so κ holds: the
     /// lobe's 1 − mean cosine moves under 1 % (0.2 % measured, at m = 0.5)
     /// from F0 = 0.028 to the iors 1.33, 1.55 and the largest allowed, 3.
