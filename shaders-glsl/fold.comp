@@ -1,5 +1,5 @@
 #version 460
-// The fold term of one blurred level (skin/fold.rs): at each listed texel x the
+// The fold term of one blurred level (skin/fold/): at each listed texel x the
 // level's value D becomes C·D + Σ w_y·E_y, E_y the previous level's texels: the
 // 3-D kernel where the skin comes back within reach (a seam's other side, a
 // squeezed UV region, a fold), the chain's share scaled back by the coverage it

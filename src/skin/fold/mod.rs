@@ -35,21 +35,18 @@
 //! most 1/[`MIN_KEPT`]; the air's share is still taken away and a fold's
 //! extra surface adds. A texel is listed where |C − 1| + Σ|w_y| ≥ [`MIN_ERROR`].
 
+mod cache;
+mod pass;
+
+pub use pass::FoldPass;
+
 use super::chain::Level;
 use super::reference::{
     gaussian, texels_of_every_triangle, Grid, MeshEdges, AIR_ELEVATION_DEG, EXTENT_SIGMA,
 };
-use crate::atomic::write_atomic;
-use crate::cache::{fnv1a64, hex};
-use crate::error::Result;
-use crate::gpu::{Buffer, Pipeline, Pipelines, Sampler};
-use crate::graph::upload::upload_buffer;
-use crate::graph::{Access, Graph, ImageHandle};
 use crate::scene::mesh::Mesh;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// A texel is corrected where |C − 1| + Σ|w_y| reaches this share of its kernel.
@@ -191,131 +188,6 @@ impl FoldTerm {
             (t + l.targets.len(), s + l.sources.len())
         })
     }
-}
-
-/// Changed with the term's rules, so that no cached term of older rules is read.
-const VERSION: &str = "fold term 6";
-/// The first bytes of a cached term.
-const MAGIC: &[u8; 8] = b"DRMFOLD1";
-
-impl FoldTerm {
-    /// The term from `cache_dir` (`fold-<key>.bin`, keyed by the mesh, the
-    /// levels and the irradiance's side), else computed and stored there.
-    pub fn load_or_compute(
-        mesh: &Mesh,
-        levels: &[Level],
-        irradiance_side: u32,
-        cache_dir: &Path,
-    ) -> FoldTerm {
-        let key = cache_key(mesh, levels, irradiance_side);
-        let path = cache_dir.join(format!("fold-{}.bin", hex(key)));
-        if let Ok(bytes) = std::fs::read(&path) {
-            match FoldTerm::from_bytes(&bytes) {
-                Some(term) => {
-                    log::info!("fold term: loaded {}", path.display());
-                    return term;
-                }
-                None => log::warn!("fold term: ignoring {}: not a whole term", path.display()),
-            }
-        }
-        let started = Instant::now();
-        let term = FoldTerm::compute(mesh, levels, irradiance_side);
-        let (targets, sources) = term.size();
-        log::info!(
-            "fold term: {targets} texels, {sources} sources in {:.1} s",
-            started.elapsed().as_secs_f64()
-        );
-        let stored = std::fs::create_dir_all(cache_dir)
-            .map_err(|e| e.to_string())
-            .and_then(|()| write_atomic(&path, term.to_bytes()).map_err(|e| e.to_string()));
-        if let Err(e) = stored {
-            log::warn!("fold term: cannot cache {}: {e}", path.display());
-        }
-        term
-    }
-
-    /// MAGIC, the level count, then per level its index, sides and list
-    /// lengths (u32, little-endian) and the lists as stored on the GPU.
-    fn to_bytes(&self) -> Vec<u8> {
-        let mut out = MAGIC.to_vec();
-        out.extend((self.levels.len() as u32).to_le_bytes());
-        for l in &self.levels {
-            for n in [
-                l.level as u32,
-                l.side,
-                l.source_side,
-                l.targets.len() as u32,
-                l.sources.len() as u32,
-            ] {
-                out.extend(n.to_le_bytes());
-            }
-            out.extend_from_slice(bytemuck::cast_slice(&l.targets));
-            out.extend_from_slice(bytemuck::cast_slice(&l.sources));
-        }
-        out
-    }
-
-    /// [`FoldTerm::to_bytes`] read back; `None` unless whole and consistent.
-    fn from_bytes(bytes: &[u8]) -> Option<FoldTerm> {
-        let mut r = Reader(bytes.strip_prefix(MAGIC)?);
-        let mut term = FoldTerm::default();
-        for _ in 0..r.u32()? {
-            let [level, side, source_side, targets, sources] = [(); 5].map(|()| r.u32());
-            let (targets, sources) = (targets? as usize, sources? as usize);
-            let t: Vec<Target> =
-                bytemuck::pod_collect_to_vec(r.take(targets * size_of::<Target>())?);
-            let s: Vec<Source> =
-                bytemuck::pod_collect_to_vec(r.take(sources * size_of::<Source>())?);
-            if t.iter()
-                .any(|t| t.first as usize + t.count as usize > s.len())
-            {
-                return None;
-            }
-            term.levels.push(FoldLevel {
-                level: level? as usize,
-                side: side?,
-                source_side: source_side?,
-                targets: t,
-                sources: s,
-            });
-        }
-        r.0.is_empty().then_some(term)
-    }
-}
-
-/// The unread rest of a cached term.
-struct Reader<'a>(&'a [u8]);
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
-        let (head, tail) = (self.0.get(..n)?, self.0.get(n..)?);
-        self.0 = tail;
-        Some(head)
-    }
-
-    fn u32(&mut self) -> Option<u32> {
-        self.take(4)
-            .map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")))
-    }
-}
-
-/// The cache key: the mesh, the irradiance's side and every level's side and σ.
-fn cache_key(mesh: &Mesh, levels: &[Level], irradiance_side: u32) -> u64 {
-    let floats = |v: &mut Vec<u8>, f: &[f32]| v.extend(f.iter().flat_map(|x| x.to_le_bytes()));
-    let mut bytes = VERSION.as_bytes().to_vec();
-    for p in mesh.positions.iter().chain(&mesh.normals) {
-        floats(&mut bytes, &p.to_array());
-    }
-    for uv in &mesh.uvs {
-        floats(&mut bytes, &uv.to_array());
-    }
-    bytes.extend(mesh.indices.iter().flat_map(|i| i.to_le_bytes()));
-    bytes.extend(irradiance_side.to_le_bytes());
-    for l in levels {
-        bytes.extend(l.resolution.to_le_bytes());
-        floats(&mut bytes, &[l.sigma_mm.unwrap_or(-1.0)]);
-    }
-    fnv1a64(&bytes)
 }
 
 /// ∂P/∂u and ∂P/∂v (mm per UV unit) of every triangle; zero where its UVs are
@@ -846,67 +718,11 @@ fn screen(coarse: &Surface, edges: &MeshEdges, v: f32, parent: Option<&Screen>) 
     }
 }
 
-/// The term on the GPU: per level, its lists, and the pass that applies them
-/// to the level's image in place (shaders-glsl/fold.comp).
-pub struct FoldPass {
-    pipeline: Arc<Pipeline>,
-    sampler: Arc<Sampler>,
-    /// (level index, targets, their buffer, the sources' buffer)
-    levels: Vec<(usize, u32, Arc<Buffer>, Arc<Buffer>)>,
-}
-
-impl FoldPass {
-    pub fn new(pipelines: &Pipelines, term: &FoldTerm, sampler: Arc<Sampler>) -> Result<Self> {
-        let ctx = pipelines.ctx();
-        let mut levels = Vec::new();
-        for l in term.levels.iter().filter(|l| !l.targets.is_empty()) {
-            let name = |what: &str| format!("fold {what} of blur{}", l.level + 1);
-            let upload = |what: &str, bytes: &[u8]| {
-                upload_buffer(ctx, &name(what), bytes, Access::ShaderBufferRead)
-            };
-            // A source list may be empty (a texel only rescaled): keep one entry.
-            let sources = if l.sources.is_empty() {
-                vec![Source {
-                    texel: 0,
-                    weight: 0.0,
-                }]
-            } else {
-                l.sources.clone()
-            };
-            levels.push((
-                l.level,
-                l.targets.len() as u32,
-                upload("targets", bytemuck::cast_slice(&l.targets))?,
-                upload("sources", bytemuck::cast_slice(&sources))?,
-            ));
-        }
-        Ok(FoldPass {
-            pipeline: pipelines.compute("fold.comp", &[])?,
-            sampler,
-            levels,
-        })
-    }
-
-    /// Applies level `k`'s term (0: blur1) to `level`, blurred from `src`.
-    pub fn pass(&self, g: &mut Graph, k: usize, src: &ImageHandle, level: &mut ImageHandle) {
-        let Some((_, count, targets, sources)) = self.levels.iter().find(|l| l.0 == k) else {
-            return;
-        };
-        // blurK_fold, after blurK (skin::blur::BlurChain::level_name).
-        g.simple_pass(&format!("blur{}_fold", k + 1), &self.pipeline)
-            .tag(super::TAG)
-            .sample(src, &self.sampler)
-            .load_store(level)
-            .buffer(targets)
-            .buffer(sources)
-            .constants(count)
-            .dispatch([*count, 1, 1]);
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::cache::cache_key;
     use super::*;
+    use crate::cache::hex;
     use crate::skin::reference::Diffusion;
 
     const SIDE: u32 = 128;
