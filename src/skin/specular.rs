@@ -22,6 +22,7 @@
 
 use super::walk::fresnel_dielectric;
 use glam::Vec3;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Normal-incidence Fresnel reflectance of skin: ((n−1)/(n+1))² with n ≈ 1.4
@@ -131,14 +132,15 @@ impl Lobe {
     /// `n_phi` grid: the renderer's start-up table (256 × 64 is within 1e-5 of
     /// the fine grid).
     pub fn albedo_lut(self, size_cos: usize, size_m: usize, n_xi: usize, n_phi: usize) -> Vec<f32> {
-        let mut lut = Vec::with_capacity(size_cos * size_m);
-        for j in 0..size_m {
-            for i in 0..size_cos {
-                let (c, m) = (table_point(i, size_cos), table_point(j, size_m));
-                lut.push(albedo_f64(f64::from(c), f64::from(m), self, n_xi, n_phi) as f32);
-            }
-        }
-        lut
+        (0..size_m)
+            .into_par_iter()
+            .flat_map_iter(|j| {
+                (0..size_cos).map(move |i| {
+                    let (c, m) = (table_point(i, size_cos), table_point(j, size_m));
+                    albedo_f64(f64::from(c), f64::from(m), self, n_xi, n_phi) as f32
+                })
+            })
+            .collect()
     }
 }
 

@@ -12,6 +12,7 @@ use crate::graph::SimplePass;
 use crate::scene::file::{SpecularRegion, REGION_COUNT};
 use crate::scene::texture::Texture;
 use ash::vk;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// 256² keeps linear interpolation of D within ~0.5 % over the lobe at m = 0.3.
@@ -47,6 +48,7 @@ pub fn beckmann_table(n: usize) -> Vec<f32> {
 pub fn albedo_table(n: usize, lobe: Lobe) -> Vec<f32> {
     let a = lobe.albedo_lut(n, n, 256, 64);
     let mean: Vec<f32> = (0..n)
+        .into_par_iter()
         .map(|j| lobe.hemispherical_albedo(specular::table_point(j, n)))
         .collect();
     a.iter()
