@@ -234,7 +234,7 @@ fn specular_of_directional_and_point_lights_matches_the_cpu_brdf() {
 /// ρs = 1/π). A sphere of Jensen's skin1 at ior 1.33 and 1.55 under one
 /// directional light 110° from the view, the specular view: each against the
 /// CPU lobe pixel by pixel (1 % + 1/255 of the peak; Schlick's Fresnel at the
-/// ior's F0 is 10–20 % under the exact one at these angles), and the 1.55
+/// ior's F0 is about a fifth under the exact one at these angles), and the 1.55
 /// sphere's specular over the 1.33 one's, summed over the pixels compared,
 /// against the CPU's ratio, the Fresnel ratio at the pixels' angles: 2.32 at
 /// H·V = 1, about 1.6 at this light's H·V ≈ 0.57. The tolerance is a tenth of
