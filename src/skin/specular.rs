@@ -649,32 +649,37 @@ mod tests {
     fn albedo_matches_direct_integration_over_light_directions() {
         // Independent check, as d'Eon's computeRhodtTex does it: integrate
         // ks_brdf(ρ_s = 1) · sin θ_L over (θ_L, φ_L) with a fine midpoint grid.
-        let n = Vec3::Z;
         let mut worst = 0.0_f64;
         for &c in &[0.2_f32, 0.5, 1.0] {
-            let v = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
             for &m in &[0.3_f32, 0.5, 0.8] {
-                let (nt, np) = (2000, 1000);
-                let mut s = 0.0_f64;
-                for i in 0..nt {
-                    let t = (i as f64 + 0.5) / nt as f64 * PI / 2.0;
-                    for j in 0..np {
-                        let p = (j as f64 + 0.5) / np as f64 * PI;
-                        let l = Vec3::new(
-                            (t.sin() * p.cos()) as f32,
-                            (t.sin() * p.sin()) as f32,
-                            t.cos() as f32,
-                        );
-                        s += f64::from(ks_brdf(n, l, v, m, 1.0, F0_SKIN)) * t.sin();
-                    }
-                }
-                let direct = s * (PI / 2.0 / nt as f64) * (PI / np as f64) * 2.0;
+                let direct = direct_albedo(Lobe::PAPER, c, m, (2000, 1000));
                 let a = f64::from(specular_albedo(c, m, F0_SKIN));
                 worst = worst.max((a - direct).abs());
             }
         }
         println!("albedo vs direct integration over L: max |Δ| = {worst:.2e}");
         assert!(worst < 1e-4);
+    }
+
+    /// ∫ `lobe`.eval(N, L, V, m, 1) dω_L over the hemisphere, V at `c` from N
+    /// in the xz-plane: an `nt` × `np` midpoint grid in (θ_L, φ_L ∈ (0, π)),
+    /// doubled (the integrand is even in φ).
+    fn direct_albedo(lobe: Lobe, c: f32, m: f32, (nt, np): (usize, usize)) -> f64 {
+        let v = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
+        let mut s = 0.0_f64;
+        for i in 0..nt {
+            let t = (i as f64 + 0.5) / nt as f64 * PI / 2.0;
+            for j in 0..np {
+                let p = (j as f64 + 0.5) / np as f64 * PI;
+                let l = Vec3::new(
+                    (t.sin() * p.cos()) as f32,
+                    (t.sin() * p.sin()) as f32,
+                    t.cos() as f32,
+                );
+                s += f64::from(lobe.eval(Vec3::Z, l, v, m, 1.0)) * t.sin();
+            }
+        }
+        s * (PI / 2.0 / nt as f64) * (PI / np as f64) * 2.0
     }
 
     /// Max error of the energy factor 1 − ρ_s·A read bilinearly from the
@@ -858,24 +863,9 @@ mod tests {
         println!("largest deviation {:.2} %", 100.0 * worst);
         assert!(worst < 0.01, "{worst}");
 
-        // Lobe::eval over a (θ_L, φ_L) midpoint grid, V at cos θ = 0.6.
+        // Lobe::eval integrated over light directions, V at cos θ = 0.6.
         let (lobe, m, cos) = (Lobe::Dielectric { ior: 1.4 }, 0.3f32, 0.6f32);
-        let v = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
-        let (n_t, n_p) = (512, 512);
-        let mut sum = 0.0f64;
-        for i in 0..n_t {
-            let theta = (i as f64 + 0.5) / n_t as f64 * PI / 2.0;
-            for j in 0..n_p {
-                let phi = (j as f64 + 0.5) / n_p as f64 * 2.0 * PI;
-                let l = Vec3::new(
-                    (theta.sin() * phi.cos()) as f32,
-                    (theta.sin() * phi.sin()) as f32,
-                    theta.cos() as f32,
-                );
-                let d_omega = theta.sin() * (PI / 2.0 / n_t as f64) * (2.0 * PI / n_p as f64);
-                sum += f64::from(lobe.eval(Vec3::Z, l, v, m, 1.0)) * d_omega;
-            }
-        }
+        let sum = direct_albedo(lobe, cos, m, (512, 256));
         let table = f64::from(lobe.albedo(cos, m));
         println!("eval integrated {sum:.5}, table {table:.5}");
         assert!((sum / table - 1.0).abs() < 0.005, "{sum} vs {table}");
