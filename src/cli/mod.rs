@@ -54,7 +54,7 @@ Environment:
   DERMIS_VALIDATION=1       Khronos validation + synchronization validation (as --validation)
   DERMIS_ASSETS=DIR         the assets folder (default scene, CC0 maps), searched first
   DERMIS_NO_BUILD_ASSETS=1  never fall back on the build's checkout for assets
-  DERMIS_CACHE_DIR=DIR      per-vertex transfer, media tables and pipeline cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
+  DERMIS_CACHE_DIR=DIR      per-vertex transfer, media and specular tables, pipeline cache (default $XDG_CACHE_HOME/dermis or ~/.cache/dermis)
   RUST_LOG=LEVEL            log filter (overrides -v)
   LP_NUM_THREADS=N          lavapipe's rasterizer threads (recorded in reports)
   DISPLAY                   the X display `dermis view` opens its window on

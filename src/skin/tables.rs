@@ -4,6 +4,8 @@
 //! face regions' parameters.
 
 use super::specular::{self, Lobe};
+use crate::atomic::write_atomic;
+use crate::cache::{default_cache_dir, fnv1a64_parts, hex};
 use crate::error::Result;
 use crate::frame_inputs::FrameInputs;
 use crate::gpu::{Context, Image, ImageDesc, Sampler};
@@ -13,7 +15,8 @@ use crate::scene::file::{SpecularRegion, REGION_COUNT};
 use crate::scene::texture::Texture;
 use ash::vk;
 use rayon::prelude::*;
-use std::sync::Arc;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 /// 256² keeps linear interpolation of D within ~0.5 % over the lobe at m = 0.3.
 pub const BECKMANN_SIZE: usize = 256;
@@ -55,6 +58,73 @@ pub fn albedo_table(n: usize, lobe: Lobe) -> Vec<f32> {
         .enumerate()
         .flat_map(|(k, &a)| [a, mean[k / n]])
         .collect()
+}
+
+/// Bump when [`albedo_table`]'s values change for the same lobe and size
+/// (its quadrature, the lobes' formulas): the cached files' key includes it.
+const ALBEDO_TABLE_VERSION: u32 = 1;
+
+/// [`albedo_table`] made once per process and kept in `cache_dir`: its 200 M
+/// integrand evaluations are about a second of CPU at every start-up
+/// otherwise.
+pub fn cached_albedo_table(n: usize, lobe: Lobe, cache_dir: &Path) -> Arc<[f32]> {
+    static MADE: Mutex<Vec<(PathBuf, Arc<[f32]>)>> = Mutex::new(Vec::new());
+    let path = albedo_table_file(n, lobe, cache_dir);
+    let made =
+        |m: &Vec<(PathBuf, Arc<[f32]>)>| m.iter().find(|(p, _)| *p == path).map(|(_, t)| t.clone());
+    if let Some(t) = made(&MADE.lock().unwrap_or_else(|e| e.into_inner())) {
+        return t;
+    }
+    let table: Arc<[f32]> = load_or_compute_albedo_table(&path, n, lobe).into();
+    MADE.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push((path, table.clone()));
+    table
+}
+
+/// `specular-albedo-<key>.json` in `cache_dir`, the key a hash of the lobe,
+/// the size and [`ALBEDO_TABLE_VERSION`].
+fn albedo_table_file(n: usize, lobe: Lobe, cache_dir: &Path) -> PathBuf {
+    let form: u8 = match lobe {
+        Lobe::Ks { .. } => 0,
+        Lobe::Dielectric { .. } => 1,
+    };
+    let key = fnv1a64_parts([
+        &ALBEDO_TABLE_VERSION.to_le_bytes()[..],
+        &[form],
+        &lobe.parameter().to_bits().to_le_bytes(),
+        &(n as u64).to_le_bytes(),
+    ]);
+    cache_dir.join(format!("specular-albedo-{}.json", hex(key)))
+}
+
+/// The table in `path`, else computed and stored there. A file that does not
+/// parse or has the wrong length is a warning and is replaced; one that
+/// cannot be written is a warning.
+fn load_or_compute_albedo_table(path: &Path, n: usize, lobe: Lobe) -> Vec<f32> {
+    if let Ok(bytes) = std::fs::read(path) {
+        match serde_json::from_slice::<Vec<f32>>(&bytes) {
+            Ok(t) if t.len() == 2 * n * n => return t,
+            Ok(t) => log::warn!(
+                "specular: ignoring {}: {} values, not {}",
+                path.display(),
+                t.len(),
+                2 * n * n
+            ),
+            Err(e) => log::warn!("specular: ignoring {}: {e}", path.display()),
+        }
+    }
+    let t = albedo_table(n, lobe);
+    let stored = path
+        .parent()
+        .map_or(Ok(()), std::fs::create_dir_all)
+        .map_err(|e| e.to_string())
+        .and_then(|()| serde_json::to_vec(&t).map_err(|e| e.to_string()))
+        .and_then(|bytes| write_atomic(path, bytes).map_err(|e| e.to_string()));
+    if let Err(e) = stored {
+        log::warn!("specular: cannot cache {}: {e}", path.display());
+    }
+    t
 }
 
 pub struct SpecularTables {
@@ -108,7 +178,7 @@ impl SpecularTables {
                 "specular albedo table",
                 (ALBEDO_SIZE, ALBEDO_SIZE),
                 vk::Format::R32G32_SFLOAT,
-                albedo_table(ALBEDO_SIZE, lobe),
+                cached_albedo_table(ALBEDO_SIZE, lobe, &default_cache_dir()).to_vec(),
             )?,
             params: upload_texture(
                 ctx,
@@ -158,5 +228,40 @@ mod tests {
         // The paper's table is d'Eon's at his F0.
         let ks = specular::specular_albedo_lut(n, n, 256, 64, specular::F0_SKIN);
         assert_eq!(albedo_table(n, Lobe::PAPER)[2], ks[1]);
+    }
+
+    #[test]
+    fn the_albedo_table_is_kept_on_disk_and_a_damaged_file_is_replaced() {
+        let dir = std::env::temp_dir().join(format!("dermis-albedo-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (n, lobe) = (5, Lobe::Dielectric { ior: 1.4 });
+        let path = albedo_table_file(n, lobe, &dir);
+        assert_ne!(
+            path,
+            albedo_table_file(n, Lobe::Dielectric { ior: 1.41 }, &dir)
+        );
+        assert_ne!(path, albedo_table_file(n, Lobe::Ks { f0: 1.4 }, &dir));
+        assert_ne!(path, albedo_table_file(n + 1, lobe, &dir));
+        let want = albedo_table(n, lobe);
+        let read =
+            |p: &Path| serde_json::from_slice::<Vec<f32>>(&std::fs::read(p).unwrap()).unwrap();
+        // Computed and stored exactly.
+        assert_eq!(load_or_compute_albedo_table(&path, n, lobe), want);
+        assert_eq!(read(&path), want);
+        // What the file holds is what a later start-up gets.
+        let marked = vec![0.5f32; 2 * n * n];
+        std::fs::write(&path, serde_json::to_vec(&marked).unwrap()).unwrap();
+        assert_eq!(load_or_compute_albedo_table(&path, n, lobe), marked);
+        // A truncated, short or foreign file is computed afresh and replaced.
+        for damage in [&b"[0.5, 0.25"[..], b"[0.5]", b"not json"] {
+            std::fs::write(&path, damage).unwrap();
+            assert_eq!(load_or_compute_albedo_table(&path, n, lobe), want);
+            assert_eq!(read(&path), want);
+        }
+        // The process's memo answers for the same file.
+        let a = cached_albedo_table(n, lobe, &dir);
+        std::fs::remove_file(&path).unwrap();
+        assert!(Arc::ptr_eq(&a, &cached_albedo_table(n, lobe, &dir)));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
