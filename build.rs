@@ -154,10 +154,24 @@ fn main() {
 
     let mut table = String::from("pub static SHADERS: &[(&str, &[u32])] = &[\n");
     let mut failures = Vec::new();
+    // A source with an `#ifdef SKIP_WORK` block is compiled twice: as it is,
+    // and with SKIP_WORK defined as `<name>:skip-work` (gpu::shaders), the
+    // timing variant with its work skipped. Defining it in a second module
+    // leaves the first one's SPIR-V, and so every image, as they were.
+    let mut variants: Vec<(PathBuf, String, String)> = Vec::new();
     for path in &sources {
-        println!("cargo:rerun-if-changed={}", path.display());
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(path).expect("unreadable shader source");
+        if text.contains("#ifdef SKIP_WORK") {
+            let (version, rest) = text.split_once('\n').expect("a #version line");
+            let skipping = format!("{version}\n#define SKIP_WORK 1\n#line 2\n{rest}");
+            variants.push((path.clone(), format!("{name}:skip-work"), skipping));
+        }
+        variants.push((path.clone(), name, text));
+    }
+    for (path, name, text) in variants {
+        let path = &path;
+        println!("cargo:rerun-if-changed={}", path.display());
         let source = ShaderSource::from(text);
         let mut includes = Includes {
             root: root.clone(),
@@ -173,7 +187,7 @@ fn main() {
         }
         match spirv {
             Ok(words) => {
-                let file = out.join(format!("{name}.spv"));
+                let file = out.join(format!("{}.spv", name.replace(':', ".")));
                 let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
                 std::fs::write(&file, bytes).expect("cannot write SPIR-V");
                 // Stored as u32 words: 4-byte aligned, as ash::util::read_spv wants.

@@ -9,6 +9,12 @@ void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     if (any(greaterThanEqual(p, pc.size))) return;
     vec4 x = vec4(vec2(p) / vec2(pc.size), 0.25, 0.5);
+#ifdef SKIP_WORK
+    // The variant with the work skipped (build.rs, `render --variants`): one
+    // read and the output, nothing else.
+    imageStore(dst, ivec2(p), x);
+    return;
+#endif
     for (uint i = 0u; i < pc.iterations; i++) {
         x = sin(x * 1.7 + 0.3) * cos(x.yzwx * 0.9 - 0.1);
     }

@@ -32,6 +32,12 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, size))) return;
     vec2 uv = (vec2(p) + 0.5) / vec2(size);
+#ifdef SKIP_WORK
+    // The variant with the work skipped (build.rs, `render --variants`): one
+    // read and the output, nothing else.
+    imageStore(dst, p, textureLod(src, uv, 0.0));
+    return;
+#endif
     vec2 src_size = vec2(textureSize(src, 0));
     // Stretch in source texels per mm; far out in the gutter there is no
     // stretch to normalise: one destination texel per mm.

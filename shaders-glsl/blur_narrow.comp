@@ -88,6 +88,12 @@ void main() {
     if (any(greaterThanEqual(p, size))) return;
     vec2 texel = 1.0 / vec2(size);
     vec2 uv = (vec2(p) + 0.5) * texel;
+#ifdef SKIP_WORK
+    // The variant with the work skipped (build.rs, `render --variants`): one
+    // read and the output, nothing else.
+    imageStore(dst, p, textureLod(src, uv, 0.0));
+    return;
+#endif
     // (r, g, b) in texels of this size per mm; in the gutter, one texel per mm.
     vec4 st = textureLod(stretch, uv, 0.0);
     vec2 scale = vec2(size) / vec2(textureSize(stretch, 0));

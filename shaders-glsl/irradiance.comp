@@ -45,6 +45,12 @@ void main() {
     ivec2 size = imageSize(irradiance);
     if (any(greaterThanEqual(texel, size))) return;
     uvec4 t = texelFetch(texel_map, texel, 0);
+#ifdef SKIP_WORK
+    // The variant with the work skipped (build.rs, `render --variants`): one
+    // read and the output, nothing else.
+    imageStore(irradiance, texel, vec4(unpackUnorm2x16(t.w), 0.0, float(t.x != 0u)));
+    return;
+#endif
     if (t.x == 0u) {
         imageStore(irradiance, texel, vec4(0.0));
         return;

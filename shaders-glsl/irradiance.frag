@@ -41,6 +41,12 @@ layout(location = 0) out vec4 irradiance;
 void main() {
     ivec2 texel = ivec2(gl_FragCoord.xy);
     vec4 s = texelFetch(surface_normal_params, texel, 0);
+#ifdef SKIP_WORK
+    // The variant with the work skipped (build.rs, `render --variants`): one
+    // read and the output, nothing else.
+    irradiance = vec4(s.zw, 0.0, 1.0);
+    return;
+#endif
     vec3 n = octahedral_decode(s.xy * 2.0 - 1.0);
     vec4 a = texelFetch(surface_albedo_mix, texel, 0);
     vec3 e = irradiance_at(v_occluded, v_position, v_normal, n, v_uv, s.zw, a.a);

@@ -81,6 +81,12 @@ pub struct RenderArgs {
     /// pipelineStatisticsQuery feature (docs/design/pass-analysis.md, "Work counters").
     #[arg(long)]
     counters: bool,
+    /// After the measured runs, run the frame once more with every shader
+    /// that has the variant skipping its work (one read and its output kept):
+    /// each such pass's time there as a share of its time, and the bound-by
+    /// verdict from it (docs/design/pass-analysis.md, "Controlled variants").
+    #[arg(long)]
+    variants: bool,
 }
 
 #[derive(Args)]
@@ -126,6 +132,7 @@ pub fn render(args: RenderArgs, context: &ContextOptions) -> dermis::Result<()> 
         runs: args.runs,
         warmup: args.warmup,
         warmup_ms: args.warmup_ms,
+        variants: args.variants,
     };
     opts.warmup_frames()?;
     let loaded = dermis::skin::with_medium_albedo(Scene::load(args.overrides.apply(file)?)?);

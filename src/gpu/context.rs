@@ -95,6 +95,9 @@ pub struct Context {
     pipeline_cache: PipelineCache,
     /// Whether a pipeline was made through the cache (else it is not saved).
     pipelines_made: AtomicBool,
+    /// Pipelines made from now on skip their shaders' work
+    /// ([`Context::set_skip_work`]).
+    skip_work: AtomicBool,
     calibrated: Option<ash::ext::calibrated_timestamps::Device>,
     queue: Mutex<vk::Queue>,
     /// Held by work that must not wait behind another thread's (see [`Context::foreground`]).
@@ -242,6 +245,7 @@ impl Context {
             push_descriptor,
             pipeline_cache,
             pipelines_made: AtomicBool::new(false),
+            skip_work: AtomicBool::new(false),
             calibrated,
             queue: Mutex::new(queue),
             foreground: Mutex::new(()),
@@ -284,6 +288,18 @@ impl Context {
     pub(crate) fn pipeline_cache(&self) -> vk::PipelineCache {
         self.pipelines_made.store(true, Ordering::Relaxed);
         self.pipeline_cache.raw
+    }
+
+    /// Pipelines made from now on, while `skip`, use the variant of each shader
+    /// that has one with its work skipped (build.rs, `#ifdef SKIP_WORK`): the
+    /// timing variant of docs/design/pass-analysis.md. Pipelines made before
+    /// keep theirs.
+    pub fn set_skip_work(&self, skip: bool) {
+        self.skip_work.store(skip, Ordering::Relaxed);
+    }
+
+    pub(crate) fn skip_work(&self) -> bool {
+        self.skip_work.load(Ordering::Relaxed)
     }
 
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {

@@ -56,6 +56,17 @@ fn specialization_entries(values: &[u32]) -> Vec<vk::SpecializationMapEntry> {
         .collect()
 }
 
+/// The shader a pipeline made now uses for `name`: its variant with the work
+/// skipped (shaders::skip_work_name) while [`Context::set_skip_work`] is on
+/// and it has one, else itself.
+fn shader_for(ctx: &Context, name: &str) -> String {
+    if ctx.skip_work() && shaders::has_skip_work(name) {
+        shaders::skip_work_name(name)
+    } else {
+        name.to_string()
+    }
+}
+
 pub struct Pipeline {
     ctx: Arc<Context>,
     pub name: String,
@@ -69,6 +80,9 @@ pub struct Pipeline {
     /// How long the driver took to create it (pipeline creation feedback,
     /// core in Vulkan 1.3), where it said.
     pub creation_ns: Option<f64>,
+    /// Made with its shaders' variants that skip their work
+    /// ([`Context::set_skip_work`]).
+    pub work_skipped: bool,
 }
 
 /// The feedback's duration, where the driver marked it valid.
@@ -117,6 +131,7 @@ impl Pipeline {
             stages,
             interface,
             creation_ns: None,
+            work_skipped: false,
         };
         let ranges = [vk::PushConstantRange {
             stage_flags: stages,
@@ -152,7 +167,9 @@ impl Pipeline {
             vk::ShaderStageFlags::COMPUTE,
             ShaderLayout::of(shader)?,
         )?;
-        let module = ShaderModule::new(ctx, shader)?;
+        let used = shader_for(ctx, shader);
+        p.work_skipped = used != shader;
+        let module = ShaderModule::new(ctx, &used)?;
         let entries = specialization_entries(specialization);
         let spec = vk::SpecializationInfo::default()
             .map_entries(&entries)
@@ -190,8 +207,10 @@ impl Pipeline {
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             ShaderLayout::of(desc.vertex)?.merge(&ShaderLayout::of(desc.fragment)?)?,
         )?;
-        let vs = ShaderModule::new(ctx, desc.vertex)?;
-        let fs = ShaderModule::new(ctx, desc.fragment)?;
+        let (vertex, fragment) = (shader_for(ctx, desc.vertex), shader_for(ctx, desc.fragment));
+        p.work_skipped = vertex != desc.vertex || fragment != desc.fragment;
+        let vs = ShaderModule::new(ctx, &vertex)?;
+        let fs = ShaderModule::new(ctx, &fragment)?;
         let entries = specialization_entries(desc.specialization);
         let spec = vk::SpecializationInfo::default()
             .map_entries(&entries)
@@ -338,5 +357,32 @@ impl<'a> ShaderModule<'a> {
 impl Drop for ShaderModule<'_> {
     fn drop(&mut self) {
         unsafe { self.ctx.device.destroy_shader_module(self.raw, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shaders_with_a_work_skipped_variant_have_it_embedded() {
+        for name in [
+            "alu_heavy.comp",
+            "blur.comp",
+            "blur_narrow.comp",
+            "irradiance.comp",
+            "irradiance.frag",
+            "skin.frag",
+        ] {
+            assert!(shaders::has_skip_work(name), "{name}");
+            let (a, b) = (
+                shaders::spirv(name).unwrap(),
+                shaders::spirv(&shaders::skip_work_name(name)).unwrap(),
+            );
+            assert_ne!(a, b, "{name}");
+        }
+        for name in ["ruler_copy.comp", "skin.vert", "tonemap.frag"] {
+            assert!(!shaders::has_skip_work(name), "{name}");
+        }
     }
 }

@@ -12,3 +12,15 @@ pub fn spirv(name: &str) -> Result<&'static [u32]> {
         .map(|(_, words)| *words)
         .ok_or_else(|| Error::Graph(format!("no embedded shader named {name:?}")))
 }
+
+/// The name under which build.rs keeps a shader's variant with its work
+/// skipped (its `#ifdef SKIP_WORK` block compiled in).
+pub fn skip_work_name(name: &str) -> String {
+    format!("{name}:skip-work")
+}
+
+/// Whether `name` has a variant with its work skipped.
+pub fn has_skip_work(name: &str) -> bool {
+    let variant = skip_work_name(name);
+    SHADERS.iter().any(|(n, _)| *n == variant)
+}

@@ -19,6 +19,7 @@
 use super::pass_cx::{Descriptor, PassCx};
 use super::{Access, BufferHandle, BufferRef, Graph, ImageHandle, ImageRef, LoadOp, PassBuilder};
 use crate::gpu::{Buffer, Image, Pipeline, Sampler};
+use crate::timing::{DRAW_TAG, WORK_SKIPPED_TAG};
 use ash::vk;
 use std::sync::Arc;
 
@@ -75,9 +76,18 @@ pub struct SimplePass<'g> {
 
 impl Graph {
     /// A pass that runs `pipeline` once; declare its bindings in order.
+    /// A pipeline made with its work skipped tags the pass
+    /// [`WORK_SKIPPED_TAG`] (and a draw [`DRAW_TAG`]) for the timing report.
     pub fn simple_pass(&mut self, name: &str, pipeline: &Arc<Pipeline>) -> SimplePass<'_> {
+        let mut pass = self.add_pass(name);
+        if pipeline.work_skipped {
+            pass.tag(WORK_SKIPPED_TAG);
+            if pipeline.bind_point == vk::PipelineBindPoint::GRAPHICS {
+                pass.tag(DRAW_TAG);
+            }
+        }
         SimplePass {
-            pass: self.add_pass(name),
+            pass,
             pipeline: pipeline.clone(),
             bindings: Vec::new(),
             constants: Vec::new(),

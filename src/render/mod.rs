@@ -61,6 +61,11 @@ pub struct RenderOptions {
     /// before the frames that count (`None`: [`PREROLL_GPU_MS`] on GPUs, 0 on
     /// CPU devices). Only when some frame is measured.
     pub warmup_ms: Option<u32>,
+    /// After the runs, one more with every shader that has the variant
+    /// skipping its work (gpu::Context::set_skip_work): each such pass's
+    /// time there over its time, and the bound-by verdict from it
+    /// (RunReport::with_work_skipped). Its image is not kept.
+    pub variants: bool,
 }
 
 /// The default pre-roll on GPUs. An NVIDIA H200 left idle between a sweep's
@@ -106,6 +111,7 @@ impl Default for RenderOptions {
             runs: 1,
             warmup: None,
             warmup_ms: None,
+            variants: false,
         }
     }
 }
@@ -283,6 +289,13 @@ pub fn render_scene(
         warmup as usize,
         r.memory,
     );
+    if opts.variants {
+        ctx.set_skip_work(true);
+        let skipped = Frame::new(ctx, scene, albedo, skin.clone(), opts.ruler)
+            .and_then(|frame| run(ctx, scene, &frame, &opts.view, opts));
+        ctx.set_skip_work(false);
+        out.report = out.report.with_work_skipped(&skipped?.report);
+    }
     out.report.preroll_ms = preroll_ms;
     out.report.pipelines = pipelines;
     Ok(out)

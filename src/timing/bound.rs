@@ -21,6 +21,17 @@ pub const MEMORY_OF_RULER: f64 = 0.5;
 /// (Fatahalian et al. 2010, "Reducing shading on GPUs using quad-fragment
 /// merging", Fig. 2: ≥ 2× over-shading at 10-pixel triangles).
 pub const FRAGMENTS_PER_TRIANGLE: f64 = 10.0;
+/// A pass that, with its shader's work skipped (one read and its output
+/// kept: `render --variants`), takes at most this share of its time is bound
+/// by that work; above it, by what the variant keeps: the output and, for a
+/// draw, rasterisation and the depth test.
+pub const SKIPPED_SHARE: f64 = 0.5;
+
+/// The tag of a pass whose pipeline was made with its work skipped
+/// (gpu::Context::set_skip_work).
+pub const WORK_SKIPPED_TAG: &str = "work-skipped";
+/// The tag a work-skipped pass that draws carries beside it.
+pub const DRAW_TAG: &str = "draw";
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
@@ -62,11 +73,18 @@ pub struct PassFigures {
     /// Nominal bandwidth over the copy ruler's.
     pub of_ruler_bandwidth: Option<f64>,
     pub counters: Option<PassCounters>,
+    /// Its median with its shader's work skipped over its median
+    /// (`render --variants`); `None` where not measured.
+    pub work_skipped_share: Option<f64>,
+    /// It draws (else it dispatches), where the variant said.
+    pub draw: bool,
 }
 
 /// The first rule that holds, in this order: overhead (within
 /// [`OVERHEAD_X_EMPTY`] of an empty dispatch), memory (≥ [`MEMORY_OF_RULER`]
-/// of the copy's bandwidth), fixed function (a draw of fewer than
+/// of the copy's bandwidth), the work-skipped variant where it ran (shading
+/// at most [`SKIPPED_SHARE`] of the time left, else fixed function for a
+/// draw and memory for a dispatch), fixed function (a draw of fewer than
 /// [`FRAGMENTS_PER_TRIANGLE`] fragments per triangle after clipping), else
 /// shading. `None` without the empty dispatch or the ruler to judge by.
 pub fn bound_by(f: &PassFigures) -> Option<BoundBy> {
@@ -84,6 +102,23 @@ pub fn bound_by(f: &PassFigures) -> Option<BoundBy> {
             bound: Bound::Memory,
             why: format!("{:.0} % of the copy ruler's bandwidth", 100.0 * bw),
         });
+    }
+    if let Some(share) = f.work_skipped_share {
+        let kept = format!(
+            "with its work skipped it takes {:.0} % of its time",
+            100.0 * share
+        );
+        let (bound, why) = if share <= SKIPPED_SHARE {
+            (Bound::Shading, kept)
+        } else if f.draw {
+            (
+                Bound::FixedFunction,
+                format!("{kept}: rasterisation, depth test, output"),
+            )
+        } else {
+            (Bound::Memory, format!("{kept}: one read and the output"))
+        };
+        return Some(BoundBy { bound, why });
     }
     if let Some(c) = f.counters.filter(|c| c.clipping_primitives > 0) {
         let per = c.fragment_invocations as f64 / c.clipping_primitives as f64;
@@ -116,6 +151,8 @@ mod tests {
             empty_ns: Some(1000.0),
             of_ruler_bandwidth: Some(bw),
             counters: None,
+            work_skipped_share: None,
+            draw: false,
         }
     }
 
@@ -143,6 +180,18 @@ mod tests {
             ..Default::default()
         });
         assert_eq!(b(&small), Bound::Shading);
+        // The work-skipped variant, after the bandwidth and before the counters.
+        let mut skipped = figures(1e6, 0.1);
+        skipped.work_skipped_share = Some(0.2);
+        assert_eq!(b(&skipped), Bound::Shading);
+        skipped.work_skipped_share = Some(0.8);
+        assert_eq!(b(&skipped), Bound::Memory);
+        skipped.draw = true;
+        let v = bound_by(&skipped).unwrap();
+        assert_eq!(v.bound, Bound::FixedFunction);
+        assert!(v.why.contains("80 % of its time"), "{}", v.why);
+        skipped.of_ruler_bandwidth = Some(0.9);
+        assert_eq!(b(&skipped), Bound::Memory);
         // Nothing to judge by.
         let mut none = figures(1e6, 0.1);
         none.empty_ns = None;

@@ -19,7 +19,7 @@ pub mod trace;
 mod ttest;
 mod verdict;
 
-pub use bound::{Bound, BoundBy};
+pub use bound::{Bound, BoundBy, DRAW_TAG, WORK_SKIPPED_TAG};
 pub use counters::PassCounters;
 pub use fingerprint::Fingerprint;
 pub use run::{

@@ -1,6 +1,6 @@
 //! What `--report FILE.json` writes: what was run, where, and what it cost.
 
-use super::bound::{bound_by, BoundBy, PassFigures};
+use super::bound::{bound_by, BoundBy, PassFigures, DRAW_TAG, WORK_SKIPPED_TAG};
 use super::fingerprint::{run_id, timestamp, Fingerprint};
 use super::stats::Stats;
 use super::{FrameTiming, PassCounters, PassTime};
@@ -163,6 +163,10 @@ pub struct PassStats {
     /// serve some of it, or it touches less than it declares).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub of_ruler_bandwidth: Option<f64>,
+    /// Its median with its shader's work skipped (one read and the output
+    /// kept) over its median, where `render --variants` ran that variant.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub work_skipped_share: Option<f64>,
     /// What bounds the pass (timing::bound), where the rulers ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bound_by: Option<BoundBy>,
@@ -334,21 +338,6 @@ impl RunReport {
             p.x_ruler = p.ns_per_texel.zip(ruler_ns).map(|(a, r)| a / r);
             p.of_ruler_bandwidth = touched(p).zip(ruler_gb).map(|(a, r)| a / r);
         }
-        let empty_ns = passes
-            .iter()
-            .find(|p| p.name == RULER_EMPTY)
-            .and_then(|p| p.time)
-            .map(|t| t.median_ns);
-        for p in &mut passes {
-            p.bound_by = p.time.and_then(|t| {
-                bound_by(&PassFigures {
-                    median_ns: t.median_ns,
-                    empty_ns,
-                    of_ruler_bandwidth: p.of_ruler_bandwidth,
-                    counters: p.counters,
-                })
-            });
-        }
         let spans = measured.iter().map(|f| f.gpu_frame_ns).collect();
         let first_run = per_frame.first().map_or(0, |f| f.run);
         let warmup_only = per_frame
@@ -368,7 +357,7 @@ impl RunReport {
             .any(|f| f.passes.iter().any(|p| p.counters.is_some()));
         let mut runs: Vec<u32> = per_frame.iter().map(|f| f.run).collect();
         runs.dedup();
-        Self {
+        let mut report = Self {
             schema_version: SCHEMA_VERSION,
             dermis_version: VERSION.into(),
             git_commit: GIT_COMMIT.into(),
@@ -395,7 +384,59 @@ impl RunReport {
             per_frame,
             validation_messages: device.validation.then(crate::gpu::validation_messages),
             pipelines: Vec::new(),
+        };
+        report.judge(&[]);
+        report
+    }
+
+    /// Each pass's verdict (timing::bound), `draws` naming the passes that draw.
+    fn judge(&mut self, draws: &[String]) {
+        let empty_ns = self
+            .passes
+            .iter()
+            .find(|p| p.name == RULER_EMPTY)
+            .and_then(|p| p.time)
+            .map(|t| t.median_ns);
+        for p in &mut self.passes {
+            p.bound_by = p.time.and_then(|t| {
+                bound_by(&PassFigures {
+                    median_ns: t.median_ns,
+                    empty_ns,
+                    of_ruler_bandwidth: p.of_ruler_bandwidth,
+                    counters: p.counters,
+                    work_skipped_share: p.work_skipped_share,
+                    draw: draws.contains(&p.name),
+                })
+            });
         }
+    }
+
+    /// The work-skipped variant's figures from `skipped`, a run of the same
+    /// frame whose pipelines skipped their shaders' work
+    /// (gpu::Context::set_skip_work): each pass it tagged [`WORK_SKIPPED_TAG`]
+    /// gets its median there over its median here, and the verdicts follow.
+    pub fn with_work_skipped(mut self, skipped: &RunReport) -> Self {
+        let tagged = |p: &&PassStats, tag: &str| p.tags.iter().any(|t| t == tag);
+        let varied: Vec<&PassStats> = skipped
+            .passes
+            .iter()
+            .filter(|p| tagged(p, WORK_SKIPPED_TAG))
+            .collect();
+        for p in &mut self.passes {
+            let full = p.time.map(|t| t.median_ns).filter(|&t| t > 0.0);
+            let kept = varied
+                .iter()
+                .find(|v| v.name == p.name)
+                .and_then(|v| v.time);
+            p.work_skipped_share = full.zip(kept).map(|(f, k)| k.median_ns / f);
+        }
+        let draws: Vec<String> = varied
+            .iter()
+            .filter(|p| tagged(p, DRAW_TAG))
+            .map(|p| p.name.clone())
+            .collect();
+        self.judge(&draws);
+        self
     }
 
     /// The measured frames, every run's warm-up left out.
