@@ -117,7 +117,7 @@ impl Scene {
                 load(&t.regions, Encoding::Linear, texture::DEFAULT_REGION)?,
             ),
             None => {
-                let head = head::build_head(&head::HeadParams::default());
+                let head = head::default_head().clone();
                 let size = head.texture_size;
                 let tex = |rgba8, encoding| Texture {
                     width: size,
@@ -207,7 +207,7 @@ impl Scene {
 pub fn load_mesh(file: &SceneFile) -> Result<Mesh> {
     Ok(match &file.mesh {
         Some(path) => gltf::load_mesh(path, file.mm_per_unit)?,
-        None => head::build_head(&head::HeadParams::default()).mesh,
+        None => head::default_head().mesh.clone(),
     })
 }
 

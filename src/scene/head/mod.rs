@@ -103,6 +103,13 @@ pub struct BuiltinHead {
 // ---------------------------------------------------------------------------------
 // Public entry points.
 
+/// The default head ([`HeadParams::default`]), built once per process (about a
+/// second of CPU) and shared: every scene without a mesh loads a copy.
+pub fn default_head() -> &'static BuiltinHead {
+    static HEAD: std::sync::OnceLock<BuiltinHead> = std::sync::OnceLock::new();
+    HEAD.get_or_init(|| build_head(&HeadParams::default()))
+}
+
 /// Builds the head: mesh, atlas and textures. Deterministic for given parameters.
 pub fn build_head(params: &HeadParams) -> BuiltinHead {
     let grid_mm = if params.grid_mm.is_finite() {
@@ -144,16 +151,13 @@ pub fn build_head(params: &HeadParams) -> BuiltinHead {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::OnceLock;
-
     use glam::Vec2;
 
     use super::*;
 
     /// One default build shared by the tests of all files (≈ 1 s in release).
     pub(super) fn head() -> &'static BuiltinHead {
-        static HEAD: OnceLock<BuiltinHead> = OnceLock::new();
-        HEAD.get_or_init(|| build_head(&HeadParams::default()))
+        default_head()
     }
 
     /// A triangle's UVs in texels of an `n`² atlas.
