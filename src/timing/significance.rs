@@ -97,20 +97,23 @@ pub fn normal_sf(z: f64) -> f64 {
 }
 
 fn erfc(x: f64) -> f64 {
+    // Numerical Recipes in C, 2nd ed., §6.2 (erfcc): the polynomial's
+    // coefficients after the first, summed by Horner's rule as there.
+    const C: [f64; 9] = [
+        1.000_023_68,
+        0.374_091_96,
+        0.096_784_18,
+        -0.186_288_06,
+        0.278_868_07,
+        -1.135_203_98,
+        1.488_515_87,
+        -0.822_152_23,
+        0.170_872_77,
+    ];
     let z = x.abs();
     let t = 1.0 / (1.0 + 0.5 * z);
-    // Numerical Recipes in C, 2nd ed., §6.2 (erfcc).
-    let r = t
-        * (-z * z - 1.265_512_23
-            + t * (1.000_023_68
-                + t * (0.374_091_96
-                    + t * (0.096_784_18
-                        + t * (-0.186_288_06
-                            + t * (0.278_868_07
-                                + t * (-1.135_203_98
-                                    + t * (1.488_515_87
-                                        + t * (-0.822_152_23 + t * 0.170_872_77)))))))))
-            .exp();
+    let horner = C.iter().rev().fold(0.0, |acc, &c| c + t * acc);
+    let r = t * (-z * z - 1.265_512_23 + t * horner).exp();
     if x >= 0.0 {
         r
     } else {
