@@ -76,6 +76,7 @@ pub struct SimplePass<'g> {
 
 impl Graph {
     /// A pass that runs `pipeline` once; declare its bindings in order.
+    ///
     /// A pipeline made with its work skipped tags the pass
     /// [`WORK_SKIPPED_TAG`] (and a draw [`DRAW_TAG`]) for the timing report.
     pub fn simple_pass(&mut self, name: &str, pipeline: &Arc<Pipeline>) -> SimplePass<'_> {

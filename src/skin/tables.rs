@@ -99,14 +99,16 @@ fn albedo_table_file(n: usize, lobe: Lobe, cache_dir: &Path) -> PathBuf {
 }
 
 /// The table in `path`, else computed and stored there. A file that does not
-/// parse or has the wrong length is a warning and is replaced; one that
-/// cannot be written is a warning.
+/// parse, has the wrong length or a negative value is a warning and is
+/// replaced; one that cannot be written is a warning.
 fn load_or_compute_albedo_table(path: &Path, n: usize, lobe: Lobe) -> Vec<f32> {
     if let Ok(bytes) = std::fs::read(path) {
         match serde_json::from_slice::<Vec<f32>>(&bytes) {
-            Ok(t) if t.len() == 2 * n * n => return t,
+            Ok(t) if t.len() == 2 * n * n && t.iter().all(|v| v.is_finite() && *v >= 0.0) => {
+                return t
+            }
             Ok(t) => log::warn!(
-                "specular: ignoring {}: {} values, not {}",
+                "specular: ignoring {}: {} values, not {} finite and non-negative",
                 path.display(),
                 t.len(),
                 2 * n * n
@@ -252,8 +254,10 @@ mod tests {
         let marked = vec![0.5f32; 2 * n * n];
         std::fs::write(&path, serde_json::to_vec(&marked).unwrap()).unwrap();
         assert_eq!(load_or_compute_albedo_table(&path, n, lobe), marked);
-        // A truncated, short or foreign file is computed afresh and replaced.
-        for damage in [&b"[0.5, 0.25"[..], b"[0.5]", b"not json"] {
+        // A truncated, short, foreign or impossible file is computed afresh
+        // and replaced.
+        let negative = serde_json::to_vec(&vec![-0.5f32; 2 * n * n]).unwrap();
+        for damage in [&b"[0.5, 0.25"[..], b"[0.5]", b"not json", &negative] {
             std::fs::write(&path, damage).unwrap();
             assert_eq!(load_or_compute_albedo_table(&path, n, lobe), want);
             assert_eq!(read(&path), want);
