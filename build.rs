@@ -158,19 +158,18 @@ fn main() {
     // and with SKIP_WORK defined as `<name>:skip-work` (gpu::shaders), the
     // timing variant with its work skipped. Defining it in a second module
     // leaves the first one's SPIR-V, and so every image, as they were.
-    let mut variants: Vec<(PathBuf, String, String)> = Vec::new();
+    let mut modules: Vec<(&PathBuf, String, String)> = Vec::new();
     for path in &sources {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(path).expect("unreadable shader source");
         if text.contains("#ifdef SKIP_WORK") {
             let (version, rest) = text.split_once('\n').expect("a #version line");
             let skipping = format!("{version}\n#define SKIP_WORK 1\n#line 2\n{rest}");
-            variants.push((path.clone(), format!("{name}:skip-work"), skipping));
+            modules.push((path, format!("{name}:skip-work"), skipping));
         }
-        variants.push((path.clone(), name, text));
+        modules.push((path, name, text));
     }
-    for (path, name, text) in variants {
-        let path = &path;
+    for (path, name, text) in modules {
         println!("cargo:rerun-if-changed={}", path.display());
         let source = ShaderSource::from(text);
         let mut includes = Includes {

@@ -97,7 +97,6 @@ fn skipping_the_work_of_an_arithmetic_pass_leaves_little_of_its_time() {
     let pass = |name: &str| report.passes.iter().find(|p| p.name == name).unwrap();
     let alu = pass("alu");
     let share = alu.work_skipped_share.expect("alu was varied");
-    eprintln!("alu with its work skipped: {share:.3} of its time");
     // 128 rounds of sin and cos per texel against none: 4-7 % on lavapipe.
     assert!(share < 0.25, "alu keeps {share} of its time\n{table}");
     let verdict = alu.bound_by.clone().unwrap();
